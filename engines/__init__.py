@@ -1,0 +1,1 @@
+"""Engine adapters: MuJoCo and PyBullet models of a `Scene`, returning `Trajectory`."""

@@ -1,0 +1,1 @@
+"""The `harness` command: simulate, compare, bench, stress, analyze, sweep, record."""

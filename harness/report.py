@@ -1,0 +1,36 @@
+"""Plain-text renderings of results for the terminal."""
+
+from __future__ import annotations
+
+from reference.trajectory import Trajectory
+
+
+def format_simulate(traj: Trajectory) -> str:
+    e = traj.energy
+    lines = [
+        f"engine      {traj.engine}",
+        f"scene       {traj.scene}",
+        f"status      {traj.status.value}: {traj.message}",
+        f"t_final     {traj.t_final:.17g}",
+    ]
+    if traj.t_singularity is not None:
+        lines.append(f"t_sing      {traj.t_singularity:.17g}")
+    lines += [
+        f"impacts     {len(traj.impacts)}",
+        f"samples     {traj.n_samples}",
+        f"energy      {e[0]:.6e} -> {e[-1]:.6e}" if traj.n_samples else "energy      -",
+        f"wall time   {traj.stats.get('wall_time_s', float('nan')):.3f} s",
+    ]
+    if traj.impacts:
+        lines.append("first impacts (t, contact, impulse):")
+        for ev in traj.impacts[:8]:
+            lines.append(f"  {ev.t:.15f}  {ev.contact:4d}  {ev.impulse:.6e}")
+    return "\n".join(lines)
+
+
+def table(rows: list[list[str]], header: list[str]) -> str:
+    widths = [max(len(str(x)) for x in col) for col in zip(header, *rows, strict=False)]
+    fmt = "  ".join(f"{{:>{w}}}" for w in widths)
+    out = [fmt.format(*header), fmt.format(*["-" * w for w in widths])]
+    out += [fmt.format(*[str(x) for x in r]) for r in rows]
+    return "\n".join(out)

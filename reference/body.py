@@ -1,0 +1,181 @@
+"""Rigid-body model of a scene: mass, inertia, contact geometry, energy, invariants.
+
+State vector (13): position x (3), quaternion q = (w, x, y, z) body → world (4),
+velocity v (3), angular velocity ω in the world frame (3).
+
+Contacts (DESIGN.md §2):
+- `flat`: contact k is vertex k, r_k = R a(cos 2πk/n, sin 2πk/n, 0); gap = z + (r_k)_z;
+  normal e_z.
+- `three_point`: contact k is the bump at b_k = b(cos 2πk/3, sin 2πk/3, 0); the body's
+  face (plane through the centre of mass with normal e3 = R ẑ) touches it;
+  gap = (x − b_k)·e3; normal e3; lever r_k = in-plane projection of b_k − x.
+
+For both, d(gap)/dt = n·(v + ω × r) and the normal acceleration is J_k [v̇; ω̇] + bias_k
+with J_k = [nᵀ, (r_k × n)ᵀ].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import quaternion as qt
+from .scene import Scene
+
+EPS = np.finfo(float).eps
+
+X, Q, V, W = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
+
+
+@dataclass(frozen=True)
+class BodyModel:
+    mass: float
+    i1: float  # inertia about in-plane axes, m (ρ a)²
+    i3: float  # inertia about the symmetry axis, 2 m (ρ a)²
+    radius: float
+    gravity: float
+    flat: bool
+    points: np.ndarray  # body-frame vertices (flat) or world bump positions (three_point)
+
+    @classmethod
+    def from_scene(cls, scene: Scene) -> BodyModel:
+        i1, _, i3 = scene.body.inertia_diag
+        if scene.ground.kind == "flat":
+            n = scene.body.n
+            ang = 2.0 * np.pi * np.arange(n) / n
+            pts = scene.body.radius * np.stack([np.cos(ang), np.sin(ang), np.zeros(n)], axis=1)
+        else:
+            ang = 2.0 * np.pi * np.arange(3) / 3
+            b = scene.ground.bump_radius
+            pts = b * np.stack([np.cos(ang), np.sin(ang), np.zeros(3)], axis=1)
+        pts.setflags(write=False)
+        return cls(
+            mass=scene.body.mass,
+            i1=i1,
+            i3=i3,
+            radius=scene.body.radius,
+            gravity=scene.gravity,
+            flat=scene.ground.kind == "flat",
+            points=pts,
+        )
+
+    @property
+    def n_contacts(self) -> int:
+        return len(self.points)
+
+    # ------------------------------------------------------------------ inertia
+    def inertia_world(self, q: np.ndarray) -> np.ndarray:
+        """I_w = i1 1 + (i3 − i1) e3 e3ᵀ (axisymmetric body)."""
+        e3 = qt.body_axis(q)
+        return self.i1 * np.eye(3) + (self.i3 - self.i1) * np.outer(e3, e3)
+
+    def inv_inertia_world(self, q: np.ndarray) -> np.ndarray:
+        e3 = qt.body_axis(q)
+        return np.eye(3) / self.i1 + (1.0 / self.i3 - 1.0 / self.i1) * np.outer(e3, e3)
+
+    # ------------------------------------------------------------------ contacts
+    def contacts(self, y: np.ndarray):
+        """Gap, normal, lever and normal velocity of every contact at state y.
+
+        Returns (gap (k,), normal (k,3), lever (k,3), vn (k,), noise (k,)) where `noise`
+        is the roundoff level of the gap (a few ulps of the terms that form it)."""
+        x, q, v, w = y[X], y[Q], y[V], y[W]
+        if self.flat:
+            R = qt.to_matrix(q)
+            # z-row computed from the small quaternion terms directly
+            wq, xq, yq, zq = q
+            rz_row = np.array([2 * (xq * zq - wq * yq), 2 * (yq * zq + wq * xq)])
+            lever = self.points @ R.T
+            rz = self.points[:, 0] * rz_row[0] + self.points[:, 1] * rz_row[1]
+            lever[:, 2] = rz
+            gap = x[2] + rz
+            normal = np.broadcast_to(np.array([0.0, 0.0, 1.0]), lever.shape)
+            wxr = np.cross(w, lever)
+            vn = v[2] + wxr[:, 2]
+            noise = 8 * EPS * (abs(x[2]) + np.abs(rz))
+        else:
+            e3 = qt.body_axis(q)
+            d = x[None, :] - self.points  # x − b_k
+            gap = d @ e3
+            lever = -d + gap[:, None] * e3[None, :]  # in-plane part of b_k − x
+            normal = np.broadcast_to(e3, lever.shape)
+            vn = v @ e3 + np.cross(w, lever) @ e3
+            noise = 8 * EPS * (np.abs(d) @ np.abs(e3))
+        return gap, normal, lever, vn, noise
+
+    def jacobian(self, normal: np.ndarray, lever: np.ndarray) -> np.ndarray:
+        """Rows J_k = [n_kᵀ, (r_k × n_k)ᵀ] mapping (v, ω) to normal velocities."""
+        return np.concatenate([normal, np.cross(lever, normal)], axis=1)
+
+    def bias(self, y: np.ndarray, normal: np.ndarray, lever: np.ndarray) -> np.ndarray:
+        """Velocity-product part of the normal acceleration of each contact.
+
+        flat: (ω × (ω × r))_z.   three_point: 2 v·(ω × e3) + (x − b)·(ω × (ω × e3))."""
+        v, w = y[V], y[W]
+        if self.flat:
+            return np.cross(w, np.cross(w, lever))[:, 2]
+        e3 = normal[0]
+        we3 = np.cross(w, e3)
+        d = y[X][None, :] - self.points
+        return 2.0 * (v @ we3) + d @ np.cross(w, we3)
+
+    def mass_matrix_inv(self, q: np.ndarray) -> np.ndarray:
+        Minv = np.zeros((6, 6))
+        Minv[:3, :3] = np.eye(3) / self.mass
+        Minv[3:, 3:] = self.inv_inertia_world(q)
+        return Minv
+
+    def free_acceleration(self, y: np.ndarray) -> np.ndarray:
+        """[v̇; ω̇] without contact forces: gravity and the gyroscopic term −I⁻¹(ω × Iω)."""
+        q, w = y[Q], y[W]
+        Iw = self.inertia_world(q)
+        wdot = -self.inv_inertia_world(q) @ np.cross(w, Iw @ w)
+        return np.array([0.0, 0.0, -self.gravity, *wdot])
+
+    # ------------------------------------------------------------------ energy
+    def kinetic_energy(self, y: np.ndarray) -> float:
+        v, w, q = y[V], y[W], y[Q]
+        e3 = qt.body_axis(q)
+        w3 = float(w @ e3)
+        wperp2 = float(w @ w) - w3 * w3
+        return 0.5 * self.mass * float(v @ v) + 0.5 * (self.i1 * wperp2 + self.i3 * w3 * w3)
+
+    def potential_energy(self, y: np.ndarray) -> float:
+        return self.mass * self.gravity * float(y[2])
+
+    def energy(self, y: np.ndarray) -> float:
+        return self.kinetic_energy(y) + self.potential_energy(y)
+
+    def angular_momentum(self, y: np.ndarray) -> np.ndarray:
+        """About the centre of mass, world frame."""
+        return self.inertia_world(y[Q]) @ y[W]
+
+    def velocity_scale(self, y: np.ndarray) -> float:
+        """Largest speed of a body point on the rim: |v| + a|ω| (a local velocity unit)."""
+        return float(np.linalg.norm(y[V]) + self.radius * np.linalg.norm(y[W]))
+
+    def length_scale(self, y: np.ndarray) -> float:
+        """Local length unit: height of the centre plus the rim's vertical extent."""
+        e3 = qt.body_axis(y[Q])
+        return abs(float(y[2])) + self.radius * math.hypot(e3[0], e3[1])
+
+
+def initial_state(scene: Scene) -> np.ndarray:
+    ini = scene.initial
+    y = np.zeros(13)
+    y[X] = ini.position
+    y[Q] = qt.from_rotation_vector(ini.rotation_vector)
+    y[V] = ini.velocity
+    y[W] = ini.angular_velocity
+    return y
+
+
+def contact_gaps_initial(scene: Scene) -> np.ndarray:
+    model = BodyModel.from_scene(scene)
+    return model.contacts(initial_state(scene))[0]
+
+
+def body_axis_initial(scene: Scene) -> np.ndarray:
+    return qt.body_axis(initial_state(scene)[Q])
