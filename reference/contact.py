@@ -1,0 +1,180 @@
+"""Sustained contact (paper §2.2, eqs. rollF, rollM, rollc; DESIGN.md §2).
+
+With a set C of contacts held (gap 0, normal velocity 0), the normal accelerations are
+a_n = A λ + b with A = J M⁻¹ Jᵀ and b = J M⁻¹ f + bias (gravity, gyroscopic term and
+velocity products).  The forces solve the acceleration-level complementarity problem
+λ ≥ 0, a_n ≥ 0, λ·a_n = 0, solved exactly by enumerating the (at most 2³) active sets.
+
+The motion between events is integrated with DOP853 (scipy) at tight tolerances; after
+every chunk the state is projected back onto the constraints (positions, then velocities
+by normal impulses), so there is no drift.  A force reaching zero is a lift-off event.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from . import quaternion as qt
+from .body import BodyModel, Q, V, W, X
+
+
+def contact_system(model: BodyModel, y: np.ndarray, contacts: list[int]):
+    """(A, b, J, Minv, acc_free) for the contacts held, at state y."""
+    idx = np.asarray(contacts, dtype=int)
+    gap, normal, lever, vn, _ = model.contacts(y, idx)
+    J = model.jacobian(normal, lever)
+    Minv = model.mass_matrix_inv(y[Q])
+    acc_free = model.free_acceleration(y)
+    A = J @ Minv @ J.T
+    b = J @ acc_free + model.bias(y, normal, lever, idx)
+    return A, b, J, Minv, acc_free
+
+
+def solve_contact_lcp(
+    model: BodyModel, y: np.ndarray, candidates: list[int], tol: float = 0.0
+) -> tuple[list[int], np.ndarray]:
+    """Active set and forces among `candidates` (contacts with gap 0 and normal velocity 0).
+
+    Returns the active contacts (λ > 0) and their forces.  Enumerates active sets from
+    the largest; the first satisfying λ ≥ 0 and a_n ≥ −tol for the others is returned
+    (unique when A is positive definite; at roundoff-level ties the larger set, i.e.
+    holding the contact, wins)."""
+    if not candidates:
+        return [], np.zeros(0)
+    A, b, *_ = contact_system(model, y, candidates)
+    m = len(candidates)
+    best = None
+    for size in range(m, -1, -1):
+        for S in itertools.combinations(range(m), size):
+            S = list(S)
+            lam = np.zeros(m)
+            if S:
+                try:
+                    lam[S] = np.linalg.solve(A[np.ix_(S, S)], -b[S])
+                except np.linalg.LinAlgError:
+                    continue
+            if np.any(lam[S] < -tol * (1 + np.abs(lam[S]))):
+                continue
+            an = A @ lam + b
+            others = [i for i in range(m) if i not in S]
+            if np.all(an[others] >= 0.0):
+                best = (S, lam)
+                break
+        if best is not None:
+            break
+    if best is None:
+        raise RuntimeError("contact complementarity problem has no solution")
+    S, lam = best
+    active = [candidates[i] for i in S if lam[i] > 0.0]
+    return active, np.array([lam[i] for i in S if lam[i] > 0.0])
+
+
+def constrained_rhs(model: BodyModel, contacts: list[int]):
+    """dy/dt with the contacts held as bilateral constraints (forces may go negative:
+    that is the lift-off signal)."""
+
+    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+        A, b, J, Minv, acc_free = contact_system(model, y, contacts)
+        lam = np.linalg.solve(A, -b)
+        acc = acc_free + Minv @ J.T @ lam
+        dy = np.empty(13)
+        dy[X] = y[V]
+        w = y[W]
+        dy[Q] = 0.5 * qt.multiply(np.array([0.0, *w]), y[Q])
+        dy[V] = acc[:3]
+        dy[W] = acc[3:]
+        return dy
+
+    return rhs
+
+
+def contact_forces(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
+    A, b, *_ = contact_system(model, y, contacts)
+    return np.linalg.solve(A, -b)
+
+
+def constrained_acceleration(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
+    if not contacts:
+        return model.free_acceleration(y)
+    A, b, J, Minv, acc_free = contact_system(model, y, contacts)
+    lam = np.linalg.solve(A, -b)
+    return acc_free + Minv @ J.T @ lam
+
+
+def project_positions(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
+    """Move the body (translation along the normals' span and a small rotation, in the
+    mass metric) so the held contacts have gap 0.  Two Gauss–Newton passes."""
+    out = np.array(y, dtype=float)
+    for _ in range(2):
+        gap, normal, lever, _, _ = model.contacts(out, np.asarray(contacts, dtype=int))
+        J = model.jacobian(normal, lever)
+        Minv = model.mass_matrix_inv(out[Q])
+        A = J @ Minv @ J.T
+        d = Minv @ J.T @ np.linalg.solve(A, -gap)
+        out[X] += d[:3]
+        out[Q] = qt.normalize(qt.multiply(qt.from_rotation_vector(d[3:]), out[Q]))
+    return out
+
+
+def project_velocities(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
+    from .impact import apply_normal_impulses
+
+    return apply_normal_impulses(model, y, contacts, np.zeros(len(contacts)))
+
+
+def integrate_chunk(
+    model: BodyModel, y: np.ndarray, contacts: list[int], s: float, rtol: float, dense=False
+):
+    """Integrate the constrained motion for time s (DOP853) and project onto the
+    constraints.  Returns (state, ODE solution or None, number of RHS evaluations)."""
+    scale_x = model.length_scale(y) + 1e-300
+    scale_v = model.velocity_scale(y) + 1e-300
+    atol = np.empty(13)
+    atol[X] = rtol * scale_x
+    atol[Q] = rtol * scale_x / model.radius
+    atol[V] = rtol * scale_v
+    atol[W] = rtol * scale_v / model.radius
+    sol = solve_ivp(
+        constrained_rhs(model, contacts),
+        (0.0, s),
+        y,
+        method="DOP853",
+        rtol=rtol,
+        atol=atol,
+        dense_output=dense,
+    )
+    if not sol.success:
+        raise RuntimeError(f"contact integration failed: {sol.message}")
+    out = sol.y[:, -1].copy()
+    out[Q] = qt.normalize(out[Q])
+    out = project_positions(model, out, contacts)
+    out = project_velocities(model, out, contacts)
+    return out, (sol.sol if dense else None), int(sol.nfev)
+
+
+def chunk_horizon(model: BodyModel, y: np.ndarray, contacts: list[int], others_jet) -> float:
+    """Largest safe chunk: no other contact can reach the ground (quadratic lower bound
+    with K = 2 max(|g″|) + g, a factor-2 margin on the current second derivatives), and
+    the chunk stays short against the local time scale √(length / acceleration)."""
+    from .events import first_root_lower_bound
+
+    g = model.gravity
+    acc_scale = float(np.max(np.abs(others_jet.accel))) if len(others_jet.accel) else 0.0
+    K = 2.0 * acc_scale + g + 1e-300
+    h = math.inf
+    for k in range(len(others_jet.gap)):
+        if k in contacts:
+            continue
+        gk = max(others_jet.gap[k], others_jet.noise[k])
+        d = first_root_lower_bound(gk, others_jet.rate[k], others_jet.accel[k], K, 0.0)
+        h = min(h, d)
+    L = model.length_scale(y)
+    T_local = math.sqrt(max(L, 1e-300) / K)
+    vs = model.velocity_scale(y)
+    if vs > 0:
+        T_local = min(T_local, 0.2 * model.radius / vs * 10)
+    return min(h, 0.25 * T_local)
