@@ -181,7 +181,10 @@ def next_flight_event(
     for it in range(max_iter):
         jet = gap_jet(model, y, flight_acceleration(fc, y))
         touching = jet.gap <= jet.noise
-        hit = np.flatnonzero(touching & (jet.rate < -jet.rate_noise))
+        # A double root (graze) cannot be told from a hit slower than the speed a convex
+        # gap reaches inside its roundoff band, √(2 g″ noise): such a touch is a graze.
+        graze_speed = np.sqrt(2.0 * np.maximum(jet.accel, 0.0) * jet.noise) * 4.0
+        hit = np.flatnonzero(touching & (jet.rate < -np.maximum(jet.rate_noise, graze_speed)))
         if hit.size:
             return _polish(model, fc, s, jet, hit, horizon, it)
         landing = np.flatnonzero(touching & (jet.rate <= jet.rate_noise) & (jet.accel < 0))

@@ -1,0 +1,118 @@
+"""Construct the built-in scenes whose initial states need a computation:
+
+- grazing-contact: a vertex whose gap has a double root (touches with zero normal
+  velocity, pulled up by centripetal acceleration) at t = T_GRAZE; built by taking the
+  grazing state and running the closed-form flight backwards by T_GRAZE.
+- near-simultaneous: a square falling without rotation, tilted so that vertex 1 is
+  DT_APART·|v| higher than vertex 0: the two hit DT_APART ≈ 1e-12 s apart.
+
+Run: python scripts/make_scenes.py  (rewrites harness/scenes/{grazing-contact,near-simultaneous}.toml)
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import brentq
+
+from reference import quaternion as qt
+from reference.body import BodyModel
+from reference.flight import flight_constants, free_flight
+from reference.scene import Body, Ground, InitialState, Scene
+
+OUT = Path(__file__).resolve().parent.parent / "harness" / "scenes"
+T_GRAZE = 0.1
+DT_APART = 1e-12
+
+
+def _toml(name, desc, gamma, n, rho, y, t_end):
+    rv = qt.to_rotation_vector(y[3:7])
+    f = lambda v: "[" + ", ".join(repr(float(x)) for x in v) + "]"  # noqa: E731
+    return f'''name = "{name}"
+description = "{desc}"
+gravity = 1.0
+restitution = {gamma}
+
+[body]
+n = {n}
+radius = 1.0
+mass = 1.0
+gyration = {rho}
+
+[ground]
+kind = "flat"
+
+[initial]
+position = {f(y[0:3])}
+rotation_vector = {f(rv)}
+velocity = {f(y[7:10])}
+angular_velocity = {f(y[10:13])}
+
+[run]
+t_end = {t_end}
+max_impacts = 1000
+'''
+
+
+def _scene(n, rho, y):
+    return Scene(
+        name="tmp",
+        body=Body(n=n, gyration=rho),
+        ground=Ground(),
+        initial=InitialState(tuple(y[0:3]), tuple(qt.to_rotation_vector(y[3:7])),
+                             tuple(y[7:10]), tuple(y[10:13])),
+    )
+
+
+def grazing() -> str:
+    n, rho, w, tilt = 3, 0.5, -5.0, 0.1
+    model = BodyModel.from_scene(_scene(n, rho, np.r_[0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0]))
+    y = np.zeros(13)
+    # vertex 0 at body (1, 0, 0); tilt about y so it is the lowest point
+    y[3:7] = qt.from_rotation_vector([0.02, tilt, 0.0])  # asymmetric: no mirror hits
+    # horizontal spin: centripetal (ω×(ω×r))_z = −|ω|² r_z > 0 lifts the low vertex 0;
+    # v_z cancels (ω × r)_z so vertex 0 touches with zero normal velocity
+    y[10:13] = [0.5, w, 0.0]
+    gap, _, lever, _, _ = model.contacts(y)
+    y[2] = -lever[0, 2]  # vertex 0 exactly on the ground
+    y[9] = -(y[10] * lever[0, 1] - y[11] * lever[0, 0])
+    g, _, _, vn, _ = model.contacts(y)
+    assert abs(g[0]) < 1e-15 and abs(vn[0]) < 1e-14, (g, vn)
+    back = free_flight(flight_constants(model, y), -T_GRAZE)
+    assert np.all(model.contacts(back)[0] > 0)
+    return _toml("grazing-contact",
+                 f"triangle whose vertex 0 grazes the ground (double root) at t = {T_GRAZE}",
+                 0.5, n, rho, back, 0.3)
+
+
+def near_simultaneous() -> str:
+    n, rho, v, h0 = 4, 0.5, -1.0, 0.05
+    model = BodyModel.from_scene(_scene(n, rho, np.r_[0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0]))
+    phiy = 0.02
+
+    def state(phix):
+        y = np.zeros(13)
+        y[3:7] = qt.from_rotation_vector([phix, phiy, 0.0])
+        gap = model.contacts(y)[0]
+        y[2] = h0 - gap[0]
+        y[9] = v
+        return y
+
+    def diff(phix):
+        g = model.contacts(state(phix))[0]
+        return (g[1] - g[0]) - DT_APART * abs(v)
+
+    phix = brentq(diff, -0.03, -0.01, xtol=1e-17, rtol=1e-15)
+    y = state(phix)
+    g = model.contacts(y)[0]
+    assert abs((g[1] - g[0]) - DT_APART) < 1e-15 and g[0] == min(g)
+    return _toml("near-simultaneous",
+                 "square falling without spin; vertices 0 and 1 hit about 1e-12 s apart",
+                 0.5, n, rho, y, 0.5)
+
+
+if __name__ == "__main__":
+    (OUT / "grazing-contact.toml").write_text(grazing())
+    (OUT / "near-simultaneous.toml").write_text(near_simultaneous())
+    print("wrote", OUT / "grazing-contact.toml", OUT / "near-simultaneous.toml")
