@@ -60,8 +60,9 @@ def _scene(n, rho, y):
         name="tmp",
         body=Body(n=n, gyration=rho),
         ground=Ground(),
-        initial=InitialState(tuple(y[0:3]), tuple(qt.to_rotation_vector(y[3:7])),
-                             tuple(y[7:10]), tuple(y[10:13])),
+        initial=InitialState(
+            tuple(y[0:3]), tuple(qt.to_rotation_vector(y[3:7])), tuple(y[7:10]), tuple(y[10:13])
+        ),
     )
 
 
@@ -81,9 +82,15 @@ def grazing() -> str:
     assert abs(g[0]) < 1e-15 and abs(vn[0]) < 1e-14, (g, vn)
     back = free_flight(flight_constants(model, y), -T_GRAZE)
     assert np.all(model.contacts(back)[0] > 0)
-    return _toml("grazing-contact",
-                 f"triangle whose vertex 0 grazes the ground (double root) at t = {T_GRAZE}",
-                 0.5, n, rho, back, 0.3)
+    return _toml(
+        "grazing-contact",
+        f"triangle whose vertex 0 grazes the ground (double root) at t = {T_GRAZE}",
+        0.5,
+        n,
+        rho,
+        back,
+        0.3,
+    )
 
 
 def near_simultaneous() -> str:
@@ -107,9 +114,15 @@ def near_simultaneous() -> str:
     y = state(phix)
     g = model.contacts(y)[0]
     assert abs((g[1] - g[0]) - DT_APART) < 1e-15 and g[0] == min(g)
-    return _toml("near-simultaneous",
-                 "square falling without spin; vertices 0 and 1 hit about 1e-12 s apart",
-                 0.5, n, rho, y, 0.5)
+    return _toml(
+        "near-simultaneous",
+        "square falling without spin; vertices 0 and 1 hit about 1e-12 s apart",
+        0.5,
+        n,
+        rho,
+        y,
+        0.5,
+    )
 
 
 if __name__ == "__main__":

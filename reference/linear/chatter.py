@@ -15,6 +15,9 @@ in the rotated frame is the linear map p ↦ M p, M = R⁻¹U0.
   p0 = eigenvector of β_p, q0 = α s + δ p0 (s the eigenvector of β_q,
   δ = β_p τ0/(β_q − β_p), α = −δ f0ᵀp0/f0ᵀs).  Intervals scale by β_q/β_p and energies
   by β_p², so E ~ (t_f − t)^c_lin with c_lin = 2 log β_p / log(β_q/β_p) (eq. clin).
+  Its stability: eigenvalues of the Jacobian (central differences) of the reduced
+  gravity-free map (impact, flight to the next vertex, rotation back, p and q each
+  normalised).
 - Rod: β_p,q = (ψ(1+γ) ± √(ψ²(1+γ)² − 4γ))/2, ψ = (1 − ρ²)/(1 + ρ²), i.e. the roots of
   x² − ψ(1+γ)x + γ.  Complete chatter without gravity needs ψ > 2√γ/(1+γ) (eq. CCcond,
   real β's); with gravity ψ > (γ^⅓ + γ^⅔)/(1+γ) (eq. CCcondgravity), which is β_q < β_p²,
@@ -120,6 +123,35 @@ def gravity_free_selfsimilar(model: LinearModel, beta_p: float, beta_q: float) -
     return {"p0": p0, "q0": q0, "tau0": tau0, "checks": ok, "feasible": all(ok.values())}
 
 
+def gravity_free_map(model: LinearModel, p: np.ndarray, q: np.ndarray):
+    """Reduced map of gravity-free chatter: impact at vertex 0, free flight at constant
+    velocity until vertex 1 lands (τ = −f1ᵀq / f1ᵀU0p), rotation back by R⁻¹, and
+    normalisation of p and q separately (without gravity (q, p, t) → (μq, νp, μt/ν) is
+    a symmetry for any μ, ν)."""
+    U0, Ri, f1 = model.U(0), model.R.T, model.F[1]
+    pa = U0 @ p
+    tau = -float(f1 @ q) / float(f1 @ pa)
+    qb = Ri @ (q + pa * tau)
+    pb = Ri @ pa
+    return pb / np.linalg.norm(pb), qb / np.linalg.norm(qb)
+
+
+def gravity_free_stability(model: LinearModel, p0: np.ndarray, q0: np.ndarray, h=1e-7):
+    """Eigenvalues of the Jacobian (central differences) of `gravity_free_map` at the
+    normalised self-similar chatter (p0, q0); the two normalisations contribute zeros."""
+    p0 = p0 / np.linalg.norm(p0)
+    q0 = q0 / np.linalg.norm(q0)
+    x0 = np.r_[p0, q0]
+    J = np.zeros((6, 6))
+    for k in range(6):
+        e = np.zeros(6)
+        e[k] = h
+        a = np.concatenate(gravity_free_map(model, (x0 + e)[:3], (x0 + e)[3:]))
+        b = np.concatenate(gravity_free_map(model, (x0 - e)[:3], (x0 - e)[3:]))
+        J[:, k] = (a - b) / (2 * h)
+    return np.linalg.eigvals(J)
+
+
 def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
     """The contract's `analyze chatter` document: eigenvalues of R⁻¹U0, CC, PCC, and
     β_p, β_q, c_lin where they exist (the rod's formulas for n = 2; for n ≥ 3 the
@@ -156,6 +188,7 @@ def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
         for bq in real[1:]:
             ss = gravity_free_selfsimilar(model, bp, bq)
             if ss is not None:
+                lam_j = gravity_free_stability(model, ss["p0"], ss["q0"])
                 pairs.append(
                     {
                         "beta_p": bp,
@@ -163,6 +196,8 @@ def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
                         "c_lin": c_lin(bp, bq),
                         "feasible": ss["feasible"],
                         "checks": ss["checks"],
+                        "spectral_radius": float(np.max(np.abs(lam_j))),
+                        "stable": bool(np.max(np.abs(lam_j)) < 1),
                     }
                 )
         doc["pairs"] = pairs
@@ -203,7 +238,7 @@ def format_chatter(doc: dict) -> str:
             ]
             for x in doc["pairs"]
         ]
-        lines.append(table(rows, ["beta_p", "beta_q", "c_lin", "feasible"]))
+        lines.append(table(rows, ["beta_p", "beta_q", "c_lin", "feasible", "spectral radius"]))
     if doc["beta_p"] is not None:
         cl = doc["c_lin"]
         lines.append(

@@ -53,71 +53,50 @@ FEAS_TOL = 1e-12
 # --------------------------------------------------------------------------- algebra
 
 
-def _poly_adjugate(A) -> np.ndarray:
-    """Adjugate of a 3×3 matrix of Polynomials (object array)."""
-    adj = np.empty((3, 3), dtype=object)
-    for i in range(3):
-        for j in range(3):
-            r = [x for x in range(3) if x != j]
-            c = [x for x in range(3) if x != i]
-            minor = A[r[0], c[0]] * A[r[1], c[1]] - A[r[0], c[1]] * A[r[1], c[0]]
-            adj[i, j] = minor if (i + j) % 2 == 0 else -minor
-    return adj
-
-
-def _poly_det(A) -> P:
-    return (
-        A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
-        - A[0, 1] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
-        + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0])
-    )
-
-
-def _poly_matvec(A, v) -> list:
-    return [sum((A[i, j] * v[j] for j in range(3)), P([0.0])) for i in range(3)]
-
-
-def _const_matvec(C: np.ndarray, v: list) -> list:
-    return [sum((v[j] * float(C[i, j]) for j in range(3)), P([0.0])) for i in range(3)]
-
-
 def smooth_acceleration(model: LinearModel) -> np.ndarray:
     """a of the phase after an impact at vertex 0: held contact (γ = 0) or flight."""
     return model.a_contact(0) if model.restitution == 0.0 else model.a_free
 
 
+def _adjugate_coefficients(M: np.ndarray):
+    """adj(xI − M) = B2 x² + B1 x + B0 and det(xI − M) = x³ + d2 x² + d1 x + d0
+    (Faddeev-LeVerrier): B2 = I, B1 = M − tr(M) I, B0 = M² − tr(M) M + c I with
+    c = (tr(M)² − tr(M²))/2, and det = x³ − tr(M) x² + c x − det(M)."""
+    I = np.eye(3)
+    t = float(np.trace(M))
+    c = 0.5 * (t * t - float(np.trace(M @ M)))
+    B = [M @ M - t * M + c * I, M - t * I, I]
+    d = [-float(np.linalg.det(M)), c, -t, 1.0]
+    return B, d
+
+
 def selfsimilar_polynomial(model: LinearModel) -> P:
-    """N(β) of the module docstring (its real roots other than eigenvalues of M are the
-    nontrivial self-similar β)."""
+    """N(β) of the module docstring, divided by its factors β (its real roots other than
+    eigenvalues of M are the nontrivial self-similar β).  Coefficients from the
+    adjugates' Faddeev-LeVerrier expansions, in x = β for βI − M and x = β² for
+    β²I − R⁻¹."""
     U0, R = model.U(0), model.R
     Ri = R.T
-    M = Ri @ U0
     a = smooth_acceleration(model)
-    beta = P([0.0, 1.0])
-    I = np.eye(3)
-    A1 = np.empty((3, 3), dtype=object)
-    A2 = np.empty((3, 3), dtype=object)
-    for i in range(3):
-        for j in range(3):
-            A1[i, j] = beta * I[i, j] - float(M[i, j])
-            A2[i, j] = beta * beta * I[i, j] - float(Ri[i, j])
-    adj1, adj2 = _poly_adjugate(A1), _poly_adjugate(A2)
-    d1 = _poly_det(A1)
+    B1, d1 = _adjugate_coefficients(Ri @ U0)
+    B2, _ = _adjugate_coefficients(Ri)
     Ria = Ri @ a
-    u = _const_matvec(U0, _poly_matvec(adj1, [P([x]) for x in Ria]))
-    inner = [u[i] + d1 * (0.5 * float(a[i])) for i in range(3)]
-    w = _poly_matvec(adj2, _const_matvec(Ri, inner))
+    # inner(β) = U0 adj1(β) R⁻¹a + det1(β) a/2 = Σ_k v_k β^k, k = 0..3
+    v = [U0 @ (B1[k] @ Ria) if k < 3 else np.zeros(3) for k in range(4)]
+    for k in range(4):
+        v[k] = v[k] + 0.5 * d1[k] * a
     f0 = model.F[0]
-    N = sum((w[i] * float(f0[i]) for i in range(3)), P([0.0]))
-    # deflate the roots at β = 0 (γ = 0: U0 is singular, N has the factor β³) and
-    # drop leading roundoff
-    c = N.coef.copy()
-    big = float(np.max(np.abs(c)))
-    while len(c) > 1 and abs(c[0]) <= 1e-12 * big:
-        c = c[1:]
-    while len(c) > 1 and abs(c[-1]) <= 1e-12 * big:
-        c = c[:-1]
-    return P(c)
+    coef = np.zeros(8)
+    for j in range(3):  # adj2 = Σ_j C_j β^(2j)
+        row = f0 @ B2[j] @ Ri
+        for k in range(4):
+            coef[2 * j + k] += float(row @ v[k])
+    big = float(np.max(np.abs(coef)))
+    while len(coef) > 1 and abs(coef[0]) <= 1e-12 * big:
+        coef = coef[1:]
+    while len(coef) > 1 and abs(coef[-1]) <= 1e-12 * big:
+        coef = coef[:-1]
+    return P(coef)
 
 
 def selfsimilar_state(model: LinearModel, beta: float, tau0: float = 1.0):
@@ -130,24 +109,29 @@ def selfsimilar_state(model: LinearModel, beta: float, tau0: float = 1.0):
     return q0, p0
 
 
-def _gap_condition(model: LinearModel, beta: float) -> float:
-    q0, _ = selfsimilar_state(model, beta)
-    return float(model.F[0] @ q0)
-
-
 def _polish(model: LinearModel, beta: float) -> float:
-    """Newton on f0ᵀq0(β) (a rational function, smooth near a simple root)."""
-    for _ in range(20):
-        h = 1e-7 * max(abs(beta), 1e-3)
-        f = _gap_condition(model, beta)
-        d = (_gap_condition(model, beta + h) - _gap_condition(model, beta - h)) / (2 * h)
-        if d == 0 or not math.isfinite(d):
+    """Secant steps on the gap condition f0ᵀq0(β) itself (solves with the model's
+    matrices: better conditioned than the expanded polynomial near β → 1)."""
+    U0, Ri, f0 = model.U(0), model.R.T, model.F[0]
+    a = smooth_acceleration(model)
+    M, I = Ri @ U0, np.eye(3)
+
+    def gap(b: float) -> float:
+        p0 = np.linalg.solve(b * I - M, Ri @ a)
+        q0 = np.linalg.solve(b * b * I - Ri, Ri @ (U0 @ p0 + 0.5 * a))
+        return float(f0 @ q0)
+
+    b0, b1 = beta, beta * (1 + 1e-8)
+    g0, g1 = gap(b0), gap(b1)
+    for _ in range(30):
+        if g1 == g0:
             break
-        step = f / d
-        beta -= step
-        if abs(step) <= 4e-16 * abs(beta):
+        b2 = b1 - g1 * (b1 - b0) / (g1 - g0)
+        b0, g0 = b1, g1
+        b1, g1 = b2, gap(b2)
+        if abs(b1 - b0) <= 2e-16 * abs(b1):
             break
-    return beta
+    return b1 if abs(g1) <= abs(g0) else b0
 
 
 # --------------------------------------------------------------------------- the map
@@ -350,7 +334,7 @@ def selfsimilar_solutions(model: LinearModel, with_stability: bool = True) -> li
             continue
         if any(abs(b - e) < 1e-9 for e in real_eigs):
             continue
-        b = _polish(model, min(max(b, 1e-12), 1 - 1e-12))
+        b = _polish(model, b)
         if not (0 < b < 1) or any(abs(b - x) < 1e-10 for x in betas):
             continue
         if any(abs(b - e) < 1e-9 for e in real_eigs):

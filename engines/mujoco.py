@@ -1,0 +1,342 @@
+"""MuJoCo adapter: run a scene in MuJoCo and return a `Trajectory` in the reference's
+conventions.
+
+Profiles (engines/mujoco_model.py explains every parameter):
+- "tuned"   → engine name "mujoco": one-step damper contact that applies Newton's law;
+- "default" → engine name "mujoco-default": MuJoCo's defaults + the documented dampratio.
+
+State conventions.  MuJoCo's free joint stores qpos = (x, q wxyz body → world) and
+qvel = (v world, ω **body frame**) (MuJoCo overview, "free joints": "the rotational
+velocities of a free joint are in the local body frame").  The reference uses ω in the
+world frame, so ω_world = R(q) ω_body (tests/test_engine_mujoco.py checks this against
+MuJoCo's own `mj_objectVelocity`).
+
+Leapfrog reading (tuned profile).  MuJoCo's Euler step is symplectic Euler,
+v⁺ = v + h a(x, v), x⁺ = x ⊕ h v⁺.  Read with v(t) as the stored velocity it is first
+order (heights under gravity lag by g h t/2, impacts come early by ~g h t/(2|vₙ|)); read
+with the stored velocity as v(t − h/2) it is the leapfrog scheme, second order in flight.
+The tuned profile starts MuJoCo at v(−h/2) (`staggered_start`) and reports whole-step
+velocities (`whole_step_velocities`).  The impact itself still happens at the first
+penetrating step: an O(h) timing error per impact that no reading removes.
+
+Recording.  `mujoco.rollout` steps in C and returns the full physics state and the
+sensor data of every step; one `contact` sensor per contact point reports the normal
+force of contact k (vertex k on flat ground, bump k on three_point).  MuJoCo detects a
+contact at the start of a step, from a state that already penetrates, and applies its
+force during that step; the impulse (force × dt) is recorded on the row of that state,
+so that `engines.base` finds the gap's zero crossing between the row before the onset
+and the onset row.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from reference.body import BodyModel, initial_state
+from reference.scene import Scene
+from reference.trajectory import Status, Trajectory
+
+from .base import build_trajectory
+from .mujoco_model import FACE_HALF_THICKNESS_FRACTION, contact_settings, load_model
+
+ENGINE_NAMES = {"tuned": "mujoco", "default": "mujoco-default"}
+STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
+# Steps per rollout call: bounds the memory of one call and lets a broken run stop early.
+CHUNK_STEPS = 200_000
+# A contact point this far below its ground (in body radii) has fallen through it: the
+# three_point face's half-thickness, past which MuJoCo would push a bump out the top.
+FALL_THROUGH_DEPTH = FACE_HALF_THICKNESS_FRACTION
+
+
+# --------------------------------------------------------------------------- states
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """R(q) v for quaternions (..., 4) wxyz and vectors (..., 3):
+    v + 2w (u × v) + 2 u × (u × v), u the vector part."""
+    w = q[..., :1]
+    u = q[..., 1:]
+    uv = np.cross(u, v)
+    return v + 2.0 * w * uv + 2.0 * np.cross(u, uv)
+
+
+def to_mujoco_state(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Reference state [x, q wxyz, v, ω world] (13) → MuJoCo (qpos (7), qvel (6)) with
+    qvel's angular part in the body frame: ω_body = R(q)ᵀ ω_world."""
+    y = np.asarray(y, dtype=float)
+    q = y[3:7]
+    q_inv = np.array([q[0], -q[1], -q[2], -q[3]])
+    return y[0:7].copy(), np.concatenate([y[7:10], rotate(q_inv, y[10:13])])
+
+
+def from_mujoco_state(qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
+    """MuJoCo (qpos (..., 7), qvel (..., 6)) → reference states (..., 13), ω_world = R ω_body."""
+    qpos = np.asarray(qpos, dtype=float)
+    qvel = np.asarray(qvel, dtype=float)
+    w_world = rotate(qpos[..., 3:7], qvel[..., 3:6])
+    return np.concatenate([qpos, qvel[..., 0:3], w_world], axis=-1)
+
+
+def set_state(model: mujoco.MjModel, data: mujoco.MjData, y: np.ndarray) -> None:
+    """Put a reference state into MuJoCo data (time 0) and run the position/velocity stages."""
+    mujoco.mj_resetData(model, data)
+    data.qpos[:], data.qvel[:] = to_mujoco_state(y)
+    mujoco.mj_forward(model, data)
+
+
+def state_from_kinematics(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """Reference state read from MuJoCo's own world-frame kinematics (after mj_forward):
+    body position and quaternion (xpos, xquat) and the body's 6D velocity in the world
+    frame from `mj_objectVelocity` (rotation first).  Independent of `from_mujoco_state`."""
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "body")
+    vel = np.zeros(6)
+    mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, bid, vel, 0)
+    return np.concatenate([data.xpos[bid], data.xquat[bid], vel[3:6], vel[0:3]])
+
+
+# --------------------------------------------------------------------------- geometry
+def contact_kinematics_vectorised(
+    scene: Scene, states: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gaps and normal velocities (N, k) of states (N, 13): the same geometry as
+    `BodyModel.contacts` (reference/body.py), for all rows at once.
+
+    flat: gap = z + (R p_k)_z, vₙ = v_z + (ω × R p_k)_z.
+    three_point: gap = (x − b_k)·e3, vₙ = v·e3 + (ω × ℓ_k)·e3 with the lever
+    ℓ_k = −(x − b_k) + gap e3, i.e. (ω × ℓ_k)·e3 = −(ω × (x − b_k))·e3."""
+    model = BodyModel.from_scene(scene)
+    x, v, w = states[:, 0:3], states[:, 7:10], states[:, 10:13]
+    qw, qx, qy, qz = states[:, 3:7].T
+    if model.flat:
+        px, py = model.points[:, 0], model.points[:, 1]
+        r0 = np.stack([1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qw * qz)], axis=1)
+        r1 = np.stack([2 * (qx * qy + qw * qz), 1 - 2 * (qx * qx + qz * qz)], axis=1)
+        r2 = np.stack([2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx)], axis=1)
+        lx = r0[:, :1] * px + r0[:, 1:] * py
+        ly = r1[:, :1] * px + r1[:, 1:] * py
+        lz = r2[:, :1] * px + r2[:, 1:] * py
+        gap = x[:, 2:3] + lz
+        vn = v[:, 2:3] + w[:, 0:1] * ly - w[:, 1:2] * lx
+        return gap, vn
+    e3 = np.stack(
+        [2 * (qx * qz + qw * qy), 2 * (qy * qz - qw * qx), 1 - 2 * (qx * qx + qy * qy)], axis=1
+    )
+    d = x[:, None, :] - model.points[None, :, :]  # (N, k, 3)
+    gap = np.einsum("nkj,nj->nk", d, e3)
+    vn = np.einsum("nj,nj->n", v, e3)[:, None] - np.einsum(
+        "nkj,nj->nk", np.cross(w[:, None, :], d), e3
+    )
+    return gap, vn
+
+
+def contact_gaps(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """Gaps (N, k) of states (N, 13)."""
+    return contact_kinematics_vectorised(scene, states)[0]
+
+
+# --------------------------------------------------------------------------- running
+@dataclass
+class MujocoRun:
+    """Per-step output of one MuJoCo run, in the reference's conventions.
+
+    Row 0 is the initial state and row j the state after step j.  `impulses[j, k]` is
+    the normal impulse (force × dt) of contact k that MuJoCo computed at state j and
+    applied during step j → j + 1."""
+
+    scene: Scene
+    profile: str
+    dt: float
+    t: np.ndarray  # (N,)
+    states: np.ndarray  # (N, 13): x, q wxyz, v, ω world
+    impulses: np.ndarray  # (N, k)
+    status: Status
+    message: str
+    stats: dict
+
+    @property
+    def forces(self) -> np.ndarray:
+        return self.impulses / self.dt
+
+
+def run_mujoco(
+    scene: Scene,
+    dt: float,
+    t_end: float | None = None,
+    profile: str = "tuned",
+    half_step: bool | None = None,
+) -> MujocoRun:
+    """Step the scene's MuJoCo model with timestep dt until t_end (scene.run.t_end by
+    default) and record every step.  `half_step` overrides the profile's leapfrog reading
+    of velocities (`staggered_start`, `whole_step_velocities`)."""
+    t_wall = time.perf_counter()
+    if profile not in ENGINE_NAMES:
+        raise ValueError(f"unknown MuJoCo profile {profile!r}; choose tuned or default")
+    t_end = scene.run.t_end if t_end is None else float(t_end)
+    n_steps = max(1, int(round(t_end / dt)))
+    settings = contact_settings(scene, dt, profile)
+    model = load_model(scene, dt, profile)
+    data = mujoco.MjData(model)
+    body = BodyModel.from_scene(scene)
+    y0 = initial_state(scene)
+    half = settings.half_step_velocities if half_step is None else half_step
+    set_state(model, data, staggered_start(body, y0, dt) if half else y0)
+    depth_limit = -FALL_THROUGH_DEPTH * scene.body.radius
+    nq, nv = model.nq, model.nv
+
+    state = np.empty(mujoco.mj_stateSize(model, STATE_SPEC))
+    mujoco.mj_getState(model, data, state, STATE_SPEC)
+    rows = [state[None].copy()]  # rollout rows: (time, qpos, qvel, ...)
+    forces: list[np.ndarray] = []  # forces[i] at the state of row i
+    after = None  # the state one step past the last row, when known
+    status, message = Status.T_END, ""
+    stepping = 0.0
+    done = 0
+    while done < n_steps:
+        chunk = min(CHUNK_STEPS, n_steps - done)
+        last = done + chunk == n_steps
+        # from state `done`: st[i] = state done + i + 1, sd[i] = sensors at state done + i;
+        # one step more than kept, so the force at the chunk's last state is known
+        t0 = time.perf_counter()
+        st, sd = rollout.rollout(model, data, state[None], nstep=chunk + 1)
+        stepping += time.perf_counter() - t0
+        st, sd = st[0], sd[0][:, 0::3]  # contact-frame force: normal component first
+        ok = _valid_rows(st, done * dt, dt)
+        if ok < chunk + 1:
+            status = Status.FAILED
+            message = f"MuJoCo's state became invalid (NaN or reset) at t = {(done + ok) * dt:.6g}"
+            rows.append(st[:ok])
+            forces.append(sd[:ok])
+            break
+        rows.append(st[:chunk])
+        forces.append(sd[: chunk + 1 if last else chunk])
+        after = st[chunk]
+        done += chunk
+        state = st[chunk - 1].copy()
+        lowest = contact_gaps(scene, _states(rows[-1], nq, nv)).min(axis=1)
+        if lowest.min() < depth_limit:
+            status = Status.FAILED
+            bad = int(np.argmax(lowest < depth_limit))
+            message = f"the body fell through the ground at t = {rows[-1][bad, 0]:.6g}"
+            after = rows[-1][bad + 1] if bad + 1 < len(rows[-1]) else None
+            rows[-1] = rows[-1][: bad + 1]
+            forces[-1] = forces[-1][: bad + 2]
+            break
+
+    rows_all = np.concatenate(rows)
+    t = dt * np.arange(len(rows_all))  # = MuJoCo's time, without its accumulated roundoff
+    states = _states(rows_all, nq, nv)
+    F = np.concatenate(forces)
+    if len(F) < len(t):  # a failed run: no force known at the last valid state
+        F = np.concatenate([F, np.zeros((len(t) - len(F), scene.n_contacts))])
+    impulses = np.clip(F[: len(t)], 0.0, None) * dt
+    if half:
+        y_after = _states(after[None], nq, nv)[0] if after is not None else None
+        states = whole_step_velocities(body, states, y_after, impulses > 0.0, dt)
+        states[0, 7:13] = y0[7:13]  # known exactly: MuJoCo started from v(−h/2) built from it
+    steps = len(t) - 1
+    stats = {
+        "wall_time_s": time.perf_counter() - t_wall,
+        "steps": steps,
+        "steps_per_s": steps / stepping if stepping > 0 else None,
+        "profile": profile,
+        "integrator": settings.integrator or "Euler (MuJoCo default)",
+        "solref": list(settings.solref) if settings.solref else "MuJoCo default",
+        "solimp": list(settings.solimp) if settings.solimp else "MuJoCo default",
+        "half_step_velocities": half,
+        "restitution_model": settings.restitution_model,
+        "mujoco_version": mujoco.__version__,
+    }
+    return MujocoRun(scene, profile, dt, t, states, impulses, status, message, stats)
+
+
+def simulate_mujoco(
+    scene: Scene,
+    dt: float,
+    t_end: float | None = None,
+    profile: str = "tuned",
+    sample_every: int = 1,
+    half_step: bool | None = None,
+) -> Trajectory:
+    """Run the scene in MuJoCo (`run_mujoco`) and return its Trajectory: samples every
+    step (thinned by `sample_every`), impacts = onsets of contact force per contact point
+    (engines.base).  stats: wall_time_s (model build + stepping + conversion, not the
+    Trajectory assembly), steps, steps_per_s (stepping alone), and the profile's
+    parameters."""
+    run = run_mujoco(scene, dt, t_end=t_end, profile=profile, half_step=half_step)
+    return build_trajectory(
+        scene,
+        ENGINE_NAMES[profile],
+        dt,
+        run.t,
+        run.states,
+        run.impulses,
+        run.status,
+        run.message,
+        run.stats,
+        sample_every,
+    )
+
+
+def staggered_start(body: BodyModel, y0: np.ndarray, dt: float) -> np.ndarray:
+    """Initial MuJoCo state for the leapfrog reading: velocities at t = −h/2,
+    [v; ω](−h/2) = [v; ω](0) − (h/2)·[v̇; ω̇]_free(y0) (gravity and gyroscopic term).
+
+    MuJoCo's Euler step is symplectic Euler, v⁺ = v + h a(x, v), x⁺ = x ⊕ h v⁺: with
+    the stored velocity read as v(t − h/2) it is the leapfrog (Störmer–Verlet) scheme,
+    whose positions are second-order accurate; read as v(t) they lag by (h/2)·a, which
+    under gravity makes every flight's height low by g h t/2 and its impacts early by
+    ~g h t/(2|vₙ|) (first order in h)."""
+    y = np.array(y0, dtype=float)
+    y[7:13] -= 0.5 * dt * body.free_acceleration(y0)
+    return y
+
+
+def whole_step_velocities(
+    body: BodyModel,
+    states: np.ndarray,
+    after: np.ndarray | None,
+    active: np.ndarray,
+    dt: float,
+) -> np.ndarray:
+    """Velocities at whole steps from MuJoCo's half-step velocities.
+
+    Row n of `states` holds x(t_n) and v(t_n − h/2); `after` is the state one step past
+    the last row (None when unknown).  In flight and in sustained contact
+    v(t_n) = (v(t_n − h/2) + v(t_n + h/2))/2 (exact for constant acceleration).  On a row
+    where a contact starts, the one-step damper applies an impact between those two
+    half steps, so the mean would mix pre- and post-impact velocities: there
+    v(t_n) = v(t_n + h/2) − (h/2)·a_free (post-impact, as the exact motion is at t_n,
+    after the gap's zero crossing)."""
+    out = states.copy()
+    nxt = np.empty_like(states[:, 7:13])
+    nxt[:-1] = states[1:, 7:13]
+    if after is not None:
+        nxt[-1] = after[7:13]
+    else:
+        nxt[-1] = states[-1, 7:13] + dt * body.free_acceleration(states[-1])[:6]
+    out[:, 7:13] = 0.5 * (states[:, 7:13] + nxt)
+    onset = active.any(axis=1)
+    onset[1:] &= (active[1:] & ~active[:-1]).any(axis=1)
+    for j in np.flatnonzero(onset):
+        y = states[j].copy()
+        y[7:13] = nxt[j]
+        out[j, 7:13] = nxt[j] - 0.5 * dt * body.free_acceleration(y)
+    return out
+
+
+def _valid_rows(st: np.ndarray, t_start: float, dt: float) -> int:
+    """Number of leading rollout rows that are finite and not a MuJoCo reset (MuJoCo
+    resets the data, time included, when its accelerations blow up)."""
+    finite = np.isfinite(st).all(axis=1)
+    expected = t_start + dt * np.arange(1, len(st) + 1)
+    sane = finite & (np.abs(st[:, 0] - expected) <= 0.5 * dt)
+    bad = np.flatnonzero(~sane)
+    return int(bad[0]) if bad.size else len(st)
+
+
+def _states(rows: np.ndarray, nq: int, nv: int) -> np.ndarray:
+    """Reference states of rollout rows (time, qpos, qvel, ...)."""
+    return from_mujoco_state(rows[:, 1 : 1 + nq], rows[:, 1 + nq : 1 + nq + nv])
