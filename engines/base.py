@@ -7,14 +7,15 @@ that impulse is positive.  An impact is the onset of activity of a contact that 
 inactive in the previous step.  Its
 
 - time is where the geometric gap (computed from the engine's own poses with the
-  reference's contact geometry) crosses zero, interpolated linearly inside the step
-  before the onset (the onset step's start when no crossing is seen);
+  reference's contact geometry) crosses zero, interpolated linearly in the interval
+  where it crosses (searched up to two intervals before the onset, since engines see a
+  contact only once it penetrates; the onset row's time when no crossing is seen);
 - impulse is the sum of the contact's impulses from the onset while the contact point
-  is still approaching or being pushed apart, i.e. until its normal velocity stops
-  increasing or the contact goes inactive (the compression + restitution phase), capped
-  at `max_impact_steps` steps so a sustained contact does not count as one long impact;
-- pre/post normal velocities are the contact point's normal velocity in the sample
-  before the onset and at the end of that window.
+  is still being pushed apart, i.e. until its normal velocity stops increasing or the
+  contact goes inactive (the compression + restitution phase), capped by a time window
+  so that a sustained contact does not count as one long impact;
+- pre/post normal velocities are the contact point's normal velocity in the last row
+  before the contact went active and in the last active row of that window.
 """
 
 from __future__ import annotations
@@ -27,14 +28,50 @@ from reference.trajectory import ImpactEvent, Status, Trajectory
 
 
 def contact_kinematics(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gap and normal velocity of every contact for states (N, 13) → two (N, k) arrays."""
+    """Gap and normal velocity (N, k) of every contact for states (N, 13), vectorised;
+    the same geometry as `BodyModel.contacts` (tests/test_engine_base.py checks it).
+
+    flat: gap = z + (R p_k)_z, vₙ = v_z + (ω × R p_k)_z.
+    three_point: gap = (x − b_k)·e3, vₙ = v·e3 − (ω × (x − b_k))·e3."""
     model = BodyModel.from_scene(scene)
-    gaps = np.empty((len(states), model.n_contacts))
-    vns = np.empty_like(gaps)
-    for i, y in enumerate(states):
-        g, _, _, vn, _ = model.contacts(y)
-        gaps[i], vns[i] = g, vn
-    return gaps, vns
+    states = np.asarray(states, dtype=float).reshape(-1, 13)
+    x, v, w = states[:, 0:3], states[:, 7:10], states[:, 10:13]
+    qw, qx, qy, qz = states[:, 3:7].T
+    if model.flat:
+        px, py = model.points[:, 0], model.points[:, 1]
+        lx = (1 - 2 * (qy * qy + qz * qz))[:, None] * px + (2 * (qx * qy - qw * qz))[:, None] * py
+        ly = (2 * (qx * qy + qw * qz))[:, None] * px + (1 - 2 * (qx * qx + qz * qz))[:, None] * py
+        lz = (2 * (qx * qz - qw * qy))[:, None] * px + (2 * (qy * qz + qw * qx))[:, None] * py
+        gap = x[:, 2:3] + lz
+        vn = v[:, 2:3] + w[:, 0:1] * ly - w[:, 1:2] * lx
+        return gap, vn
+    e3 = np.stack(
+        [2 * (qx * qz + qw * qy), 2 * (qy * qz - qw * qx), 1 - 2 * (qx * qx + qy * qy)], axis=1
+    )
+    d = x[:, None, :] - model.points[None, :, :]
+    gap = np.einsum("nkj,nj->nk", d, e3)
+    wxd = np.cross(w[:, None, :], d)
+    vn = np.einsum("nj,nj->n", v, e3)[:, None] - np.einsum("nkj,nj->nk", wxd, e3)
+    return gap, vn
+
+
+def energies(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy (N,) of states (N, 13), vectorised (reference formulas:
+    ½ m|v|² + ½ (I1 |ω⊥|² + I3 ω3²), m g z)."""
+    model = BodyModel.from_scene(scene)
+    states = np.asarray(states, dtype=float).reshape(-1, 13)
+    v, w = states[:, 7:10], states[:, 10:13]
+    qw, qx, qy, qz = states[:, 3:7].T
+    e3 = np.stack(
+        [2 * (qx * qz + qw * qy), 2 * (qy * qz - qw * qx), 1 - 2 * (qx * qx + qy * qy)], axis=1
+    )
+    w3 = np.einsum("nj,nj->n", w, e3)
+    wperp2 = np.einsum("nj,nj->n", w, w) - w3 * w3
+    ke = 0.5 * model.mass * np.einsum("nj,nj->n", v, v) + 0.5 * (
+        model.i1 * wperp2 + model.i3 * w3 * w3
+    )
+    pe = model.mass * model.gravity * states[:, 2]
+    return ke, pe
 
 
 def impacts_from_contact_activity(
@@ -42,40 +79,56 @@ def impacts_from_contact_activity(
     impulses: np.ndarray,
     gaps: np.ndarray,
     vn: np.ndarray,
-    max_impact_steps: int = 50,
+    max_impact_time: float | None = None,
 ) -> list[ImpactEvent]:
     """Impacts from per-step contact impulses (N, k), gaps (N, k), normal velocities (N, k).
 
-    Row j of `impulses` is the impulse applied during the step that ends at t[j]."""
+    Row j of `impulses` is the impulse the engine applied in the step that produced the
+    state of row j (MuJoCo and PyBullet detect a contact only once it penetrates, so the
+    gap may already be ≤ 0 at the onset row: the zero crossing is searched up to two
+    intervals back).  The impact window ends when the contact goes inactive, when its
+    normal velocity stops increasing, or after `max_impact_time` (default: 50 steps or
+    0.05 s, whichever is longer: soft default contacts last ~0.02 s); v⁺ is read at the
+    last active row of the window."""
     active = impulses > 0.0
     events: list[ImpactEvent] = []
     n_steps, n_contacts = impulses.shape
+    if n_steps == 0:
+        return events
+    dt = float(np.median(np.diff(t))) if n_steps > 1 else 0.0
+    window = max_impact_time if max_impact_time is not None else max(50 * dt, 0.05)
     for k in range(n_contacts):
         onsets = np.flatnonzero(active[1:, k] & ~active[:-1, k]) + 1
-        if n_steps and active[0, k]:
+        if active[0, k]:
             onsets = np.concatenate([[0], onsets])
         for j in onsets:
-            # time: zero crossing of the gap in the step before the onset
-            tj = t[j - 1] if j > 0 else t[0]
-            if j > 0 and gaps[j - 1, k] > 0.0 and gaps[j, k] <= 0.0:
-                g0, g1 = gaps[j - 1, k], gaps[j, k]
-                tj = t[j - 1] + (t[j] - t[j - 1]) * g0 / (g0 - g1)
-            end = j
-            total = 0.0
-            while end < n_steps and active[end, k] and end - j < max_impact_steps:
-                total += impulses[end, k]
-                if end > j and vn[end, k] <= vn[end - 1, k]:
+            tj = t[j]
+            for i in (j, j - 1, j - 2):  # crossing between rows i−1 and i
+                if i >= 1 and gaps[i - 1, k] > 0.0 and gaps[i, k] <= 0.0:
+                    g0, g1 = gaps[i - 1, k], gaps[i, k]
+                    tj = t[i - 1] + (t[i] - t[i - 1]) * g0 / (g0 - g1)
                     break
-                end += 1
-            end = min(end, n_steps - 1)
-            pre = vn[j - 1, k] if j > 0 else vn[0, k]
+            last = j
+            total = impulses[j, k]
+            i = j + 1
+            while i < n_steps and active[i, k] and t[i] - t[j] <= window:
+                if vn[i, k] <= vn[i - 1, k]:
+                    break
+                total += impulses[i, k]
+                last = i
+                i += 1
+            pre_row = max(j - 1, 0)
+            for r in (j - 1, j - 2):  # the last row that was still approaching freely
+                if r >= 0 and not active[r, k]:
+                    pre_row = r
+                    break
             events.append(
                 ImpactEvent(
                     t=float(tj),
                     contact=int(k),
                     impulse=float(total),
-                    v_normal_pre=float(pre),
-                    v_normal_post=float(vn[end, k]),
+                    v_normal_pre=float(vn[pre_row, k]),
+                    v_normal_post=float(vn[last, k]),
                 )
             )
     events.sort(key=lambda e: (e.t, e.contact))
@@ -99,15 +152,13 @@ def build_trajectory(
     `states` (N, 13) in the reference's conventions (x, q wxyz, v, ω world) and
     `impulses` (N, k) are per step; samples keep every `sample_every`-th step (and the
     last), impacts use every step."""
-    model = BodyModel.from_scene(scene)
     gaps, vns = contact_kinematics(scene, states)
     impacts = impacts_from_contact_activity(t, impulses, gaps, vns)
     keep = np.arange(0, len(t), max(1, sample_every))
     if len(t) and keep[-1] != len(t) - 1:
         keep = np.append(keep, len(t) - 1)
     S = states[keep]
-    ke = np.array([model.kinetic_energy(y) for y in S])
-    pe = np.array([model.potential_energy(y) for y in S])
+    ke, pe = energies(scene, S)
     stats = dict(stats)
     stats["min_gap"] = float(gaps.min()) if gaps.size else None
     return Trajectory(
