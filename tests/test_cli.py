@@ -1,0 +1,97 @@
+"""The `harness` command as users and outside checks call it (CONTRACT.md)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pyarrow.parquet as pq
+
+from harness.cli import main
+
+SIMULATE_FIELDS = {
+    "engine",
+    "scene",
+    "status",
+    "message",
+    "t_final",
+    "t_singularity",
+    "impacts",
+    "energy",
+    "final_state",
+    "stats",
+}
+
+
+def test_simulate_json_has_the_contract_fields(capsys):
+    assert main(["simulate", "near-simultaneous", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert SIMULATE_FIELDS <= set(doc)
+    assert doc["engine"] == "reference" and doc["scene"] == "near-simultaneous"
+    assert {"t", "contact", "impulse"} <= set(doc["impacts"][0])
+    assert {"position", "quaternion_wxyz", "velocity", "angular_velocity"} <= set(
+        doc["final_state"]
+    )
+    assert doc["status"] in {"t_end", "singularity", "simultaneous_impact", "max_impacts", "failed"}
+    assert "wall_time_s" in doc["stats"]
+
+
+def test_undecidable_physics_is_a_result_with_exit_zero(capsys, tmp_path):
+    scene = tmp_path / "square.toml"
+    scene.write_text(
+        'name = "square"\nrestitution = 0.5\n[body]\nn = 4\n[initial]\n'
+        "q = [0.0, 0.0, 0.05]\np = [0.0, 0.0, -1.0]\n"
+    )
+    assert main(["simulate", str(scene), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["status"] == "simultaneous_impact"
+    assert "0" in doc["message"]
+
+
+def test_out_writes_samples_and_impacts_as_parquet(tmp_path, capsys):
+    out = tmp_path / "run.parquet"
+    assert main(["simulate", "near-simultaneous", "--t-end", "0.1", "--out", str(out)]) == 0
+    samples = pq.read_table(out)
+    impacts = pq.read_table(tmp_path / "run.impacts.parquet")
+    assert {"t", "quaternion_w", "energy"} <= set(samples.column_names)
+    assert impacts.num_rows == 5 and set(impacts.column("contact").to_pylist()) == {0, 1, 2, 3}
+    meta = json.loads(samples.schema.metadata[b"summary"])
+    assert meta["scene"] == "near-simultaneous"
+
+
+def test_scale_option_scales_linear_coordinates(capsys):
+    assert (
+        main(["simulate", "pentagon-bounce", "--scale", "0.01", "--t-end", "0.001", "--json"]) == 0
+    )
+    doc = json.loads(capsys.readouterr().out)
+    assert abs(doc["energy"]["initial"]) < 1e-3
+
+
+def test_bad_input_exits_2_with_one_line_and_no_traceback(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n[body]\nn = 1\n[initial]\nq = [0,0,1]\np = [0,0,0]\n')
+    cases = [
+        ["simulate", "no-such-scene"],
+        ["simulate", str(bad)],
+        ["simulate", "rod", "--engine", "nonsense"],
+        ["simulate", "rod", "--t-end", "-1"],
+        ["analyze", "chatter", "--n", "3", "--gyration", "0.3", "--restitution", "2"],
+    ]
+    exe = Path(sys.executable).with_name("harness")
+    for args in cases:
+        r = subprocess.run([str(exe), *args], capture_output=True, text=True, timeout=60)
+        assert r.returncode == 2, (args, r.stderr)
+        lines = [x for x in r.stderr.splitlines() if x.strip()]
+        assert len(lines) == 1, (args, r.stderr)
+        assert "Traceback" not in r.stderr
+
+
+def test_scenes_lists_every_builtin(capsys):
+    from harness.scenes import builtin_names
+
+    assert main(["scenes"]) == 0
+    out = capsys.readouterr().out
+    for name in builtin_names():
+        assert name in out
