@@ -104,8 +104,10 @@ def _first_root_cubic(c0: float, c1: float, c2: float, c3: float) -> float:
     return math.inf
 
 
-def _bracketed_root(p, dp, lo: float, hi: float) -> float:
-    """Root of a monotone p on [lo, hi] with p(lo) > 0 ≥ p(hi); returns a point ≤ root."""
+def _bracketed_root(p, dp, lo: float, hi: float, rel: float = 1e-3) -> float:
+    """A point below the root of a monotone p on [lo, hi] with p(lo) > 0 ≥ p(hi), within
+    `rel` of it: a safe step needs no more (near a real contact the quadratic bound
+    already gives the Newton-like step)."""
     for _ in range(200):
         mid = 0.5 * (lo + hi)
         d = dp(mid)
@@ -117,7 +119,7 @@ def _bracketed_root(p, dp, lo: float, hi: float) -> float:
             lo = mid
         else:
             hi = mid
-        if hi - lo <= 4e-16 * hi:
+        if hi - lo <= rel * hi:
             break
     return lo
 
@@ -165,17 +167,24 @@ class FlightEvent:
     kind: str = "impact"  # or "activation": touching at rest and pressing in (no impact)
 
 
+USE_KERNEL = True  # compiled search for flat ground (reference.flight_kernel)
+
+
 def next_flight_event(
     model: BodyModel,
     fc: FlightConstants,
     horizon: float,
     max_iter: int = 100_000,
+    compiled: bool | None = None,
 ) -> FlightEvent | None:
     """First contact reached (approaching) within `horizon` of free flight, or None.
 
     Contacts currently touching but separating (g ≈ 0, g′ > 0, just after an impact)
-    are not events; the lower bounds carry the search past them."""
+    are not events; the lower bounds carry the search past them.  On flat ground the
+    compiled kernel runs the same search unless `compiled` is False."""
     K, B = flight_bounds(model, fc, horizon)
+    if model.flat and (USE_KERNEL if compiled is None else compiled):
+        return _next_flight_event_compiled(model, fc, horizon, max_iter, K, B)
     s = 0.0
     y = fc.y0
     for it in range(max_iter):
@@ -206,6 +215,43 @@ def next_flight_event(
         s += step
         y = free_flight(fc, s)
     raise RuntimeError("event search did not converge (max_iter)")
+
+
+def _next_flight_event_compiled(model, fc, horizon, max_iter, K, B) -> FlightEvent | None:
+    from .flight_kernel import search_flat
+
+    out = np.empty(13)
+    vscale = model.velocity_scale(fc.y0)
+    s, k, it, n_sim, k2, kind = search_flat(
+        fc.y0,
+        fc.L_over_A,
+        fc.lam,
+        fc.gravity,
+        model.points,
+        model.radius,
+        K,
+        B,
+        vscale,
+        horizon,
+        max_iter,
+        out,
+    )
+    if k == -2:
+        raise RuntimeError("event search did not converge (max_iter)")
+    if k < 0:
+        return None
+    if kind == 1:
+        return FlightEvent(s, (int(k),), out, int(it), kind="activation")
+    if n_sim > 1:
+        # name every contact reached together (rare path: recompute in Python)
+        jet = gap_jet(model, out, flight_acceleration(fc, out))
+        t_res = (jet.noise + 1e-300) / np.maximum(-jet.rate, 1e-300)
+        close = (jet.rate < -jet.rate_noise) & (
+            jet.gap / np.maximum(-jet.rate, 1e-300) <= 4.0 * (t_res + t_res[k])
+        )
+        together = sorted(set(np.flatnonzero(close).tolist()) | {int(k)})
+        return FlightEvent(s, tuple(together), out, int(it))
+    return FlightEvent(s, (int(k),), out, int(it))
 
 
 def _polish(model, fc, s, jet: GapJet, hit: np.ndarray, horizon: float, it: int) -> FlightEvent:

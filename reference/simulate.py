@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from . import events as events_mod
 from . import quaternion as qt
 from .body import BodyModel, Q, V, W, initial_state
 from .contact import (
@@ -93,6 +94,7 @@ class _Run:
     impacts: list[ImpactEvent] = field(default_factory=list)
     phases: list[Phase] = field(default_factory=list)
     stats: dict = field(default_factory=dict)
+    max_impacts: int = 100_000
 
     def sample(self, y: np.ndarray, s: float = 0.0) -> None:
         """Record state y at local time s after the clock."""
@@ -126,7 +128,7 @@ def simulate(
     wall0 = time.perf_counter()
     model = BodyModel.from_scene(scene)
     t_end = float(t_end if t_end is not None else scene.run.t_end)
-    run = _Run(model, scene.restitution, t_end, opts)
+    run = _Run(model, scene.restitution, t_end, opts, max_impacts=scene.run.max_impacts)
     run.stats.update(
         flight_search_iterations=0,
         contact_chunks=0,
@@ -249,6 +251,15 @@ def _extrapolate_singularity(run: _Run) -> float:
 
 def _flight_phase(run: _Run, y: np.ndarray, remaining: float):
     model = run.model
+    if model.flat and events_mod.USE_KERNEL and run.gamma > 0.0:
+        done, y = _bounce_compiled(run, y)
+        if done:
+            return None  # t_end reached in flight
+        if len(run.impacts) >= run.max_impacts:
+            return y, []
+        remaining = run.t_end - run.clock.hi - run.clock.lo
+        if remaining <= 0:
+            return None
     fc = flight_constants(model, y)
     ev = next_flight_event(model, fc, remaining)
     s_end = remaining if ev is None else ev.s
@@ -267,6 +278,71 @@ def _flight_phase(run: _Run, y: np.ndarray, remaining: float):
     if ev.kind == "activation":
         return _activate(run, ev.y, list(ev.contacts), [])
     return _resolve(run, ev.y, list(ev.contacts), [])
+
+
+def _bounce_compiled(run: _Run, y: np.ndarray) -> tuple[bool, np.ndarray]:
+    """Run the compiled flight/impact loop (reference.flight_kernel.bounce_loop) for as
+    long as impacts are plain single impacts.  Returns (reached t_end, state); when it
+    stops early the state is just before an event that the Python path resolves."""
+    from . import flight_kernel as fk
+
+    m = run.model
+    cap = 4096
+    imp = np.empty((cap, 6))
+    st = np.empty((2 * cap + 64, 2))
+    sy = np.empty((2 * cap + 64, 13))
+    se = np.empty((2 * cap + 64, 2))
+    sample_dt = run.opts.sample_dt or run.t_end / 2000.0
+    while True:
+        left = run.max_impacts - len(run.impacts)
+        t0 = run.clock.hi
+        code, y, hi, lo, n_imp, ns, iters, _k = fk.bounce_loop(
+            y,
+            m.mass,
+            m.i1,
+            m.i3,
+            m.gravity,
+            run.gamma,
+            m.points,
+            m.radius,
+            run.opts.chatter_tol,
+            run.clock.hi,
+            run.clock.lo,
+            run.t_end,
+            left,
+            sample_dt,
+            100_000,
+            imp,
+            st,
+            sy,
+            se,
+        )
+        run.stats["flight_search_iterations"] += int(iters)
+        for i in range(n_imp):
+            run.impacts.append(
+                ImpactEvent(
+                    t=float(imp[i, 0]),
+                    t_lo=float(imp[i, 1]),
+                    contact=int(imp[i, 2]),
+                    impulse=float(imp[i, 3]),
+                    v_normal_pre=float(imp[i, 4]),
+                    v_normal_post=float(imp[i, 5]),
+                )
+            )
+        room = run.opts.max_samples - len(run.buf.t_hi)
+        for i in range(min(ns, max(room, 0))):
+            run.buf.add(float(st[i, 0]), float(st[i, 1]), sy[i], float(se[i, 0]), float(se[i, 1]))
+        run.clock.hi, run.clock.lo = float(hi), float(lo)
+        if n_imp:
+            run.phases.append(Phase(t0, run.clock.hi, "flight"))
+        if code == fk.EXIT_FULL:
+            continue
+        if code == fk.EXIT_STUCK:
+            raise RuntimeError("event search did not converge (max_iter)")
+        if code == fk.EXIT_T_END:
+            run.sample(y)
+            return True, y
+        return False, y
 
 
 def _sample_grid(run: _Run, state_at, s_end: float) -> None:

@@ -55,7 +55,6 @@ def test_elastic_energy_is_kept_through_impacts():
     assert np.max(np.abs(E - E[0])) <= 1e-13 * E[0]
 
 
-@pytest.mark.slow
 def test_elastic_energy_drift_over_10000_impacts_is_below_1e_12():
     scene = make_scene(
         n=6, gamma=1.0, t_end=1e6, max_impacts=10_000, q=(0.01, -0.004, 0.03), p=(0.03, 0.05, -0.2)

@@ -149,6 +149,10 @@ def gravity_free_stability(model: LinearModel, p0: np.ndarray, q0: np.ndarray, h
         a = np.concatenate(gravity_free_map(model, (x0 + e)[:3], (x0 + e)[3:]))
         b = np.concatenate(gravity_free_map(model, (x0 - e)[:3], (x0 - e)[3:]))
         J[:, k] = (a - b) / (2 * h)
+    if model.rank < 3:
+        # the rod: the roll (φx, ωx) is invisible to the contacts; keep the planar block
+        keep = [1, 2, 4, 5]
+        J = J[np.ix_(keep, keep)]
     return np.linalg.eigvals(J)
 
 
@@ -235,6 +239,7 @@ def format_chatter(doc: dict) -> str:
                 f"{x['beta_q']:.9g}",
                 f"{x['c_lin']:.6g}",
                 "yes" if x["feasible"] else "no",
+                f"{x['spectral_radius']:.4g}",
             ]
             for x in doc["pairs"]
         ]

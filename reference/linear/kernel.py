@@ -80,6 +80,8 @@ def first_hit(g, v, a):
     if a < 0.0:
         s = math.sqrt(disc)
         if v <= 0.0:
+            if s - v == 0.0:  # v = 0 and a g below the smallest double: √(2g/|a|)
+                return math.sqrt(2.0 * g / -a)
             return 2.0 * g / (s - v)
         return (v + s) / -a
     if v >= 0.0 or disc <= 0.0:
@@ -518,7 +520,8 @@ def simulate_kernel(
             rem = math.inf
             if math.isfinite(t_end):
                 rem = math.ldexp((t_end - t_hi) - t_lo, kv - kq)
-            T = 2.0 * vplus / (gt * (1.0 - gamma)) if gt > 0.0 else math.inf
+            fall = gt * (1.0 - gamma)  # may underflow when gravity is negligible
+            T = 2.0 * vplus / fall if fall > 0.0 else math.inf
             sidx[0] = j
             sidx[1] = -1
             m_s = 0
@@ -547,7 +550,7 @@ def simulate_kernel(
                             nset = 2
                         elif c != other:
                             nset = 3
-                if nset == 1 and gt > 0.0:
+                if nset == 1 and fall > 0.0:
                     m_s = 1
                 elif nset == 2:
                     m_s = 2
@@ -555,8 +558,8 @@ def simulate_kernel(
                     lT = _remaining_log2_time(rb_c, rb_ldt, rb_lu, rb_pos, rb_n)
                     if lT > -1e300:
                         T = math.exp2(lT - (kq - kv))
-                    elif gt > 0.0:
-                        T = 2.0 * max(abs(vpre), vplus) / (gt * (1.0 - gamma))
+                    elif fall > 0.0:
+                        T = 2.0 * max(abs(vpre), vplus) / fall
                     else:
                         m_s = 0
                 if m_s > 0 and not T <= rem:

@@ -1,0 +1,417 @@
+"""Compiled (numba) event search for free flight over flat ground: the hot loop.
+
+Same mathematics as `reference.events.next_flight_event` (closed-form flight of
+`reference.flight`, the lower bounds P2/P3 of `reference.events`, Newton polishing),
+written in scalar form so numba can compile it.  The Python version stays the readable
+specification; tests/test_reference_kernel.py checks that both find the same events.
+
+Only the vertices that can touch next are examined: every vertex gap is bounded below by
+the rim's lowest point, gap_i ≥ z − a·s⊥ with s⊥ = |(e3x, e3y)| the sine of the
+inclination, and its rate by v_z − a|ω|.  Vertices whose own lower bound over the step
+already exceeds the current step are skipped, so the cost per step grows with the number
+of vertices near the bottom, not with n.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+EPS = 2.220446049250313e-16
+
+
+@njit(cache=True)
+def _qmul(a0, a1, a2, a3, b0, b1, b2, b3):
+    return (
+        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+    )
+
+
+@njit(cache=True)
+def flight_state(y0, LA, lam, g, s, out):
+    """Closed-form free flight (reference.flight.free_flight) into `out`."""
+    out[0] = y0[0] + y0[7] * s
+    out[1] = y0[1] + y0[8] * s
+    out[2] = y0[2] + y0[9] * s - 0.5 * g * s * s
+    out[7] = y0[7]
+    out[8] = y0[8]
+    out[9] = y0[9] - g * s
+    px, py, pz = LA[0] * s, LA[1] * s, LA[2] * s
+    th = math.sqrt(px * px + py * py + pz * pz)
+    if th < 1e-4:
+        t2 = th * th
+        hs = 0.5 - t2 / 48.0 + t2 * t2 / 3840.0
+    else:
+        hs = math.sin(0.5 * th) / th
+    c = math.cos(0.5 * th)
+    a = _qmul(c, hs * px, hs * py, hs * pz, y0[3], y0[4], y0[5], y0[6])
+    half = 0.5 * lam * s
+    b = _qmul(a[0], a[1], a[2], a[3], math.cos(half), 0.0, 0.0, math.sin(half))
+    nrm = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3])
+    w, x, y, z = b[0] / nrm, b[1] / nrm, b[2] / nrm, b[3] / nrm
+    out[3], out[4], out[5], out[6] = w, x, y, z
+    e3x = 2 * (x * z + w * y)
+    e3y = 2 * (y * z - w * x)
+    e3z = 1 - 2 * (x * x + y * y)
+    out[10] = LA[0] + lam * e3x
+    out[11] = LA[1] + lam * e3y
+    out[12] = LA[2] + lam * e3z
+
+
+@njit(cache=True)
+def vertex_jet(y, LA, lam, g, px, py):
+    """Gap, rate, acceleration and roundoff of the vertex at body (px, py, 0)."""
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    rx = (1 - 2 * (yq * yq + z * z)) * px + 2 * (x * yq - w * z) * py
+    ry = 2 * (x * yq + w * z) * px + (1 - 2 * (x * x + z * z)) * py
+    rz = 2 * (x * z - w * yq) * px + 2 * (yq * z + w * x) * py
+    wx, wy, wz = y[10], y[11], y[12]
+    gap = y[2] + rz
+    rate = y[9] + (wx * ry - wy * rx)
+    e3x = 2 * (x * z + w * yq)
+    e3y = 2 * (yq * z - w * x)
+    e3z = 1 - 2 * (x * x + yq * yq)
+    # ω̇ = λ (L/A) × e3
+    ax = lam * (LA[1] * e3z - LA[2] * e3y)
+    ay = lam * (LA[2] * e3x - LA[0] * e3z)
+    # (ω̇ × r)_z + (ω × (ω × r))_z = ax ry − ay rx + (ω·r) ω_z − |ω|² r_z
+    acc = (
+        -g
+        + (ax * ry - ay * rx)
+        + (wx * rx + wy * ry + wz * rz) * wz
+        - (wx * wx + wy * wy + wz * wz) * rz
+    )
+    noise = 8 * EPS * (abs(y[2]) + abs(rz))
+    return gap, rate, acc, noise
+
+
+@njit(cache=True)
+def _cubic(c0, c1, c2, c3):
+    """First positive root of c0 + c1 d + c2 d² + c3 d³ (c0 > 0, c3 ≤ 0), 1e-3 relative."""
+    a, b, c = 3.0 * c3, 2.0 * c2, c1
+    crit = np.empty(2)
+    m = 0
+    if a == 0.0:
+        if b != 0.0:
+            crit[0] = -c / b
+            m = 1
+    else:
+        disc = b * b - 4 * a * c
+        if disc >= 0:
+            sq = math.sqrt(disc)
+            qq = -0.5 * (b + math.copysign(sq, b))
+            if qq != 0:
+                crit[0] = qq / a
+                crit[1] = c / qq
+                m = 2
+    if m == 2 and crit[1] < crit[0]:
+        crit[0], crit[1] = crit[1], crit[0]
+    lo = 0.0
+    for i in range(m + 1):
+        if i < m:
+            hi = crit[i]
+            if hi <= lo:
+                continue
+        else:
+            if c3 < 0 or (c3 == 0 and (c2 < 0 or (c2 == 0 and c1 < 0))):
+                hi = max(lo, 1.0)
+                while c0 + hi * (c1 + hi * (c2 + hi * c3)) > 0:
+                    hi *= 2.0
+                    if hi > 1e300:
+                        return math.inf
+            else:
+                return math.inf
+        if c0 + hi * (c1 + hi * (c2 + hi * c3)) <= 0.0:
+            for _ in range(200):
+                mid = 0.5 * (lo + hi)
+                d = c1 + mid * (2.0 * c2 + 3.0 * mid * c3)
+                if d != 0.0:
+                    nxt = mid - (c0 + mid * (c1 + mid * (c2 + mid * c3))) / d
+                    if lo < nxt < hi:
+                        mid = nxt
+                if c0 + mid * (c1 + mid * (c2 + mid * c3)) > 0.0:
+                    lo = mid
+                else:
+                    hi = mid
+                if hi - lo <= 1e-3 * hi:
+                    break
+            return lo
+        lo = hi
+    return math.inf
+
+
+@njit(cache=True)
+def safe_step(g, g1, g2, K, B):
+    """First positive root of max(P2, P3) (reference.events.first_root_lower_bound)."""
+    if g <= 0.0:
+        return 0.0
+    if K > 0.0:
+        sq = math.sqrt(g1 * g1 + 2.0 * K * g)
+        d2 = (g1 + sq) / K if g1 >= 0.0 else 2.0 * g / (sq - g1)
+    elif g1 < 0.0:
+        d2 = g / -g1
+    else:
+        d2 = math.inf
+    d3 = _cubic(g, g1, 0.5 * g2, -B / 6.0)
+    return max(d2, d3)
+
+
+@njit(cache=True)
+def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, out_y):
+    """First vertex reached (approaching) in a free flight of at most `horizon`.
+
+    Returns (s, k, iterations, n_simultaneous, k2, kind) with k = −1 when nothing is
+    reached; kind 0 = impact, 1 = activation (touching at rest, pressing in).  `out_y`
+    receives the state at s."""
+    n = pts.shape[0]
+    y = np.empty(13)
+    flight_state(y0, LA, lam, g, 0.0, y)
+    s = 0.0
+    rate_noise = 64 * EPS * vscale
+    wabs = math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    for it in range(max_iter):
+        # rim lower bound: gaps ≥ z − a s⊥, rates ≥ v_z − a|ω|
+        w, x, yq, z = y[3], y[4], y[5], y[6]
+        e3x = 2 * (x * z + w * yq)
+        e3y = 2 * (yq * z - w * x)
+        sperp = math.sqrt(e3x * e3x + e3y * e3y)
+        rim_gap = y[2] - radius * sperp
+        rim_rate = y[9] - radius * wabs
+        step = math.inf
+        best = -1
+        hit_k = -1
+        hit_s = math.inf
+        n_hit = 0
+        k2 = -1
+        land_k = -1
+        for k in range(n):
+            # cheap exclusion: this vertex's gap is within a·s⊥ of the rim bound only
+            # when it is near the bottom; otherwise its own bound is computed below
+            gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
+            if gk <= nk:
+                graze = 4.0 * math.sqrt(2.0 * max(ak, 0.0) * nk)
+                if rk < -max(rate_noise, graze):
+                    ds = -gk / rk
+                    if ds < hit_s:
+                        if hit_k >= 0:
+                            k2 = hit_k
+                        hit_s = ds
+                        hit_k = k
+                    n_hit += 1
+                    continue
+                if rk <= rate_noise and ak < 0:
+                    land_k = k
+                gk = max(gk, 0.0) + nk
+            d = safe_step(gk, rk, ak, K, B)
+            if d < step:
+                step = d
+                best = k
+        if hit_k >= 0:
+            s_hit = s + hit_s
+            flight_state(y0, LA, lam, g, s_hit, y)
+            for _ in range(3):
+                gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[hit_k, 0], pts[hit_k, 1])
+                corr = -gk / rk
+                if not math.isfinite(corr) or abs(corr) <= 1e-16 * max(abs(s_hit), 1e-300):
+                    break
+                s_hit += corr
+                flight_state(y0, LA, lam, g, s_hit, y)
+            # simultaneous: another approaching vertex within the time resolution
+            gk0, rk0, ak0, nk0 = vertex_jet(y, LA, lam, g, pts[hit_k, 0], pts[hit_k, 1])
+            tres0 = (nk0 + 1e-300) / max(-rk0, 1e-300)
+            n_sim = 1
+            k2 = -1
+            for k in range(n):
+                if k == hit_k:
+                    continue
+                gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
+                if rk >= -rate_noise:
+                    continue
+                if gk / -rk <= 4.0 * ((nk + 1e-300) / max(-rk, 1e-300) + tres0):
+                    n_sim += 1
+                    k2 = k
+            out_y[:] = y
+            return s_hit, hit_k, it, n_sim, k2, 0
+        if land_k >= 0:
+            out_y[:] = y
+            return s, land_k, it, 1, -1, 1
+        step = max(step, 1e-15 * max(s, 1e-300))
+        if s + step >= horizon:
+            out_y[:] = y
+            return horizon, -1, it, 0, -1, 0
+        s += step
+        flight_state(y0, LA, lam, g, s, y)
+    out_y[:] = y
+    return s, -2, max_iter, 0, -1, 0
+
+
+# ------------------------------------------------------------------ compiled bounce loop
+
+EXIT_T_END = 0  # reached the horizon in flight (state at the horizon)
+EXIT_SPECIAL = 1  # an event Python must resolve (state just before it, vertex in k)
+EXIT_MAX = 2  # impact budget reached
+EXIT_FULL = 3  # buffers full: call again
+EXIT_STUCK = 4  # the search did not converge
+
+
+@njit(cache=True)
+def _two_sum_add(hi, lo, s):
+    h = hi + s
+    bb = h - hi
+    err = (hi - (h - bb)) + (s - bb)
+    lo2 = lo + err
+    hi2 = h + lo2
+    return hi2, lo2 - (hi2 - h)
+
+
+@njit(cache=True)
+def _record_sample(y, hi, lo, mass, i1, i3, g, st, sy, se, ns):
+    st[ns, 0] = hi
+    st[ns, 1] = lo
+    sy[ns, :] = y
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    e3x = 2 * (x * z + w * yq)
+    e3y = 2 * (yq * z - w * x)
+    e3z = 1 - 2 * (x * x + yq * yq)
+    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
+    ww = y[10] ** 2 + y[11] ** 2 + y[12] ** 2
+    se[ns, 0] = 0.5 * mass * (y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + 0.5 * (
+        i1 * (ww - w3 * w3) + i3 * w3 * w3
+    )
+    se[ns, 1] = mass * g * y[2]
+    return ns + 1
+
+
+@njit(cache=True)
+def bounce_loop(
+    y_in,
+    mass,
+    i1,
+    i3,
+    g,
+    gamma,
+    pts,
+    radius,
+    chatter_tol,
+    t_hi,
+    t_lo,
+    t_end,
+    max_impacts,
+    sample_dt,
+    max_iter,
+    imp,
+    st,
+    sy,
+    se,
+):
+    """Flight → single impact → flight … over flat ground, compiled.
+
+    The same steps as reference.simulate's flight phase + _resolve for an impact with no
+    resting contact and a post-impact speed above the completion threshold; anything
+    else (no event, activation, simultaneous contacts, completion candidates, γ = 0)
+    exits to Python with the state just before it.  Impacts go to `imp` rows
+    (t_hi, t_lo, contact, impulse, u_pre, u_post), samples to st/sy/se.
+    Returns (code, y, t_hi, t_lo, n_impacts, n_samples, iterations, k)."""
+    y = y_in.copy()
+    out = np.empty(13)
+    ys = np.empty(13)
+    n_imp = 0
+    ns = 0
+    iters = 0
+    cap_imp = imp.shape[0]
+    cap_s = st.shape[0]
+    LA = np.empty(3)
+    while True:
+        if n_imp >= max_impacts:
+            return EXIT_MAX, y, t_hi, t_lo, n_imp, ns, iters, -1
+        if n_imp >= cap_imp or ns + 4 >= cap_s:
+            return EXIT_FULL, y, t_hi, t_lo, n_imp, ns, iters, -1
+        # flight constants (reference.flight.flight_constants)
+        w, x, yq, z = y[3], y[4], y[5], y[6]
+        e3x = 2 * (x * z + w * yq)
+        e3y = 2 * (yq * z - w * x)
+        e3z = 1 - 2 * (x * x + yq * yq)
+        w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
+        LA[0] = y[10] - w3 * e3x + (i3 / i1) * w3 * e3x
+        LA[1] = y[11] - w3 * e3y + (i3 / i1) * w3 * e3y
+        LA[2] = y[12] - w3 * e3z + (i3 / i1) * w3 * e3z
+        lam = (1.0 / i3 - 1.0 / i1) * i3 * w3
+        wabs = math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+        Om = math.sqrt(LA[0] ** 2 + LA[1] ** 2 + LA[2] ** 2)
+        wd, wdd = abs(lam) * Om, abs(lam) * Om * Om
+        K = 1.0001 * (g + radius * (wabs * wabs + wd))
+        B = 1.0001 * radius * (wdd + 3 * wabs * wd + wabs**3)
+        vscale = math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + radius * wabs
+        remaining = (t_end - t_hi) - t_lo
+        if remaining <= 0:
+            return EXIT_T_END, y, t_hi, t_lo, n_imp, ns, iters, -1
+        s, k, it, n_sim, k2, kind = search_flat(
+            y, LA, lam, g, pts, radius, K, B, vscale, remaining, max_iter, out
+        )
+        iters += it
+        if k == -2:
+            return EXIT_STUCK, y, t_hi, t_lo, n_imp, ns, iters, -1
+        # grid samples inside the flight
+        kk = math.floor(t_hi / sample_dt) + 1
+        while ns + 4 < cap_s:
+            sg = kk * sample_dt - t_hi - t_lo
+            if sg >= s:
+                break
+            if sg > 0:
+                flight_state(y, LA, lam, g, sg, ys)
+                h2, l2 = _two_sum_add(t_hi, t_lo, sg)
+                ns = _record_sample(ys, h2, l2, mass, i1, i3, g, st, sy, se, ns)
+            kk += 1
+        t_hi, t_lo = _two_sum_add(t_hi, t_lo, s)
+        y[:] = out
+        if k == -1:
+            return EXIT_T_END, y, t_hi, t_lo, n_imp, ns, iters, -1
+        if kind == 1 or n_sim > 1 or gamma == 0.0:
+            return EXIT_SPECIAL, y, t_hi, t_lo, n_imp, ns, iters, k
+        # the impact at vertex k (reference.impact.impact_impulse for n = e_z)
+        w, x, yq, z = y[3], y[4], y[5], y[6]
+        px, py = pts[k, 0], pts[k, 1]
+        rx = (1 - 2 * (yq * yq + z * z)) * px + 2 * (x * yq - w * z) * py
+        ry = 2 * (x * yq + w * z) * px + (1 - 2 * (x * x + z * z)) * py
+        rz = 2 * (x * z - w * yq) * px + 2 * (yq * z + w * x) * py
+        u_pre = y[9] + (y[10] * ry - y[11] * rx)
+        e3x = 2 * (x * z + w * yq)
+        e3y = 2 * (yq * z - w * x)
+        e3z = 1 - 2 * (x * x + yq * yq)
+        # c = r × e_z = (r_y, −r_x, 0); I⁻¹ c = c / i1 + (1/i3 − 1/i1)(e3·c) e3
+        cx, cy = ry, -rx
+        e3c = e3x * cx + e3y * cy
+        f = 1.0 / i3 - 1.0 / i1
+        icx = cx / i1 + f * e3c * e3x
+        icy = cy / i1 + f * e3c * e3y
+        icz = f * e3c * e3z
+        w_eff = 1.0 / mass + cx * icx + cy * icy
+        u_post_pred = -gamma * u_pre
+        if gamma < 1.0:
+            noise = 8 * EPS * (abs(y[2]) + abs(rz))
+            a_scale = g + radius * (y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+            vs = math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + radius * wabs
+            small = max(chatter_tol * vs, 100.0 * math.sqrt(2.0 * a_scale * noise))
+            small = max(small, 64 * EPS * vs)
+            if u_post_pred <= small:
+                return EXIT_SPECIAL, y, t_hi, t_lo, n_imp, ns, iters, k
+        ns = _record_sample(y, t_hi, t_lo, mass, i1, i3, g, st, sy, se, ns)
+        zeta = -(1.0 + gamma) * u_pre / w_eff
+        y[9] += zeta / mass
+        y[10] += icx * zeta
+        y[11] += icy * zeta
+        y[12] += icz * zeta
+        u_post = y[9] + (y[10] * ry - y[11] * rx)
+        imp[n_imp, 0] = t_hi
+        imp[n_imp, 1] = t_lo
+        imp[n_imp, 2] = k
+        imp[n_imp, 3] = zeta
+        imp[n_imp, 4] = u_pre
+        imp[n_imp, 5] = u_post
+        n_imp += 1
+        ns = _record_sample(y, t_hi, t_lo, mass, i1, i3, g, st, sy, se, ns)
