@@ -15,7 +15,7 @@ from reference.simulate import simulate
         ("triangle-chatter", 50),
         ("near-simultaneous", 5),
         ("grazing-contact", 5),
-        ("elastic-hexagon", 40),
+        ("elastic-hexagon", 25),
         ("pentagon-bounce", 60),
         ("rod", 40),
     ],
