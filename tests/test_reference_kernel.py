@@ -16,7 +16,7 @@ from reference.simulate import simulate
         ("near-simultaneous", 5),
         ("grazing-contact", 5),
         ("elastic-hexagon", 25),
-        ("pentagon-bounce", 60),
+        ("pentagon-bounce", 30),
         ("rod", 40),
     ],
 )
