@@ -5,11 +5,11 @@ Same mathematics as `reference.events.next_flight_event` (closed-form flight of
 written in scalar form so numba can compile it.  The Python version stays the readable
 specification; tests/test_reference_kernel.py checks that both find the same events.
 
-Only the vertices that can touch next are examined: every vertex gap is bounded below by
-the rim's lowest point, gap_i ≥ z − a·s⊥ with s⊥ = |(e3x, e3y)| the sine of the
-inclination, and its rate by v_z − a|ω|.  Vertices whose own lower bound over the step
-already exceeds the current step are skipped, so the cost per step grows with the number
-of vertices near the bottom, not with n.
+Only the vertices that can touch next are examined (n > 32): a vertex's gap, rate and
+acceleration are linear in its body-frame position a(cos θ, sin θ), so the quadratic
+lower bound over a step δ is a sinusoid in θ and only an angular window around its
+minimum can reach the ground within δ (`_window`).  The cost per step grows with the
+number of vertices in that window, not with n.
 """
 
 from __future__ import annotations
@@ -162,55 +162,115 @@ def safe_step(g, g1, g2, K, B):
 
 
 @njit(cache=True)
+def _window(y, LA, lam, g, radius, n, K, delta, margin, idx):
+    """Indices of the vertices that can reach the ground within `delta` (the others are
+    safe by the quadratic bound P2), centred on the lowest direction; returns count.
+
+    gap_k + rate_k δ − Kδ²/2 = Z(δ) + a (cos θ_k, sin θ_k)·u(δ) with
+    Z = z + v_z δ − Kδ²/2 and u = (R20, R21) + δ (A, B), since the vertex height and its
+    rate are linear in the body-frame vertex position; vertex k is safe when
+    a |u| cos(θ_k − ∠u) ≥ −Z."""
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    R00 = 1 - 2 * (yq * yq + z * z)
+    R01 = 2 * (x * yq - w * z)
+    R10 = 2 * (x * yq + w * z)
+    R11 = 1 - 2 * (x * x + z * z)
+    R20 = 2 * (x * z - w * yq)
+    R21 = 2 * (yq * z + w * x)
+    A = y[10] * R10 - y[11] * R00
+    B = y[10] * R11 - y[11] * R01
+    ux, uy = R20 + A * delta, R21 + B * delta
+    U = math.sqrt(ux * ux + uy * uy)
+    Z = y[2] + y[9] * delta - 0.5 * K * delta * delta
+    dth = 2.0 * math.pi / n
+    centre = math.atan2(uy, ux) + math.pi
+    if radius * U <= 0.0 or -Z / (radius * U) <= -1.0:
+        half = 0
+    else:
+        c = -Z / (radius * U)
+        W = math.pi if c >= 1.0 else math.pi - math.acos(c)
+        half = int(math.ceil(W / dth))
+    half = min(half + margin, n // 2)
+    k0 = int(math.floor(centre / dth + 0.5))
+    m = 0
+    for j in range(-half, half + 1):
+        idx[m] = (k0 + j) % n
+        m += 1
+        if m >= n:
+            break
+    return m
+
+
+@njit(cache=True)
 def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, out_y):
     """First vertex reached (approaching) in a free flight of at most `horizon`.
 
     Returns (s, k, iterations, n_simultaneous, k2, kind) with k = −1 when nothing is
     reached; kind 0 = impact, 1 = activation (touching at rest, pressing in).  `out_y`
-    receives the state at s."""
+    receives the state at s.  For n > 32 only a window of vertices is examined per step
+    (see _window), so the cost per step does not grow with n."""
     n = pts.shape[0]
     y = np.empty(13)
     flight_state(y0, LA, lam, g, 0.0, y)
     s = 0.0
     rate_noise = 64 * EPS * vscale
-    wabs = math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    idx = np.empty(n, dtype=np.int64)
+    seen = np.zeros(n, dtype=np.bool_)
+    small_n = n <= 32
     for it in range(max_iter):
-        # rim lower bound: gaps ≥ z − a s⊥, rates ≥ v_z − a|ω|
-        w, x, yq, z = y[3], y[4], y[5], y[6]
-        e3x = 2 * (x * z + w * yq)
-        e3y = 2 * (yq * z - w * x)
-        sperp = math.sqrt(e3x * e3x + e3y * e3y)
-        rim_gap = y[2] - radius * sperp
-        rim_rate = y[9] - radius * wabs
         step = math.inf
-        best = -1
+        cap_step = math.inf
         hit_k = -1
         hit_s = math.inf
-        n_hit = 0
-        k2 = -1
         land_k = -1
-        for k in range(n):
-            # cheap exclusion: this vertex's gap is within a·s⊥ of the rim bound only
-            # when it is near the bottom; otherwise its own bound is computed below
-            gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
-            if gk <= nk:
-                graze = 4.0 * math.sqrt(2.0 * max(ak, 0.0) * nk)
-                if rk < -max(rate_noise, graze):
-                    ds = -gk / rk
-                    if ds < hit_s:
-                        if hit_k >= 0:
-                            k2 = hit_k
-                        hit_s = ds
-                        hit_k = k
-                    n_hit += 1
+        if small_n:
+            m = n
+            for j in range(n):
+                idx[j] = j
+        else:
+            m = _window(y, LA, lam, g, radius, n, K, 0.0, 3, idx)
+        passes = 1 if small_n else 2
+        for p in range(passes):
+            for jj in range(m):
+                k = idx[jj]
+                if seen[k]:
                     continue
-                if rk <= rate_noise and ak < 0:
-                    land_k = k
-                gk = max(gk, 0.0) + nk
-            d = safe_step(gk, rk, ak, K, B)
-            if d < step:
-                step = d
-                best = k
+                seen[k] = True
+                gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
+                if gk <= nk:
+                    graze = 4.0 * math.sqrt(2.0 * max(ak, 0.0) * nk)
+                    if rk < -max(rate_noise, graze):
+                        ds = -gk / rk
+                        if ds < hit_s:
+                            hit_s = ds
+                            hit_k = k
+                        continue
+                    if rk <= rate_noise and ak < 0:
+                        land_k = k
+                    gk = max(gk, 0.0) + nk
+                d = safe_step(gk, rk, ak, K, B)
+                if d < step:
+                    step = d
+            if p == 0 and not small_n:
+                # every vertex that could be unsafe within δ lies in window(δ): shrink δ
+                # until that window is small, and never step beyond δ
+                dlt = min(step, horizon - s)
+                m2 = _window(y, LA, lam, g, radius, n, K, dlt, 3, idx)
+                while m2 > m + 64 and dlt > 0.0:
+                    dlt *= 0.5
+                    m2 = _window(y, LA, lam, g, radius, n, K, dlt, 3, idx)
+                m = m2
+                cap_step = dlt
+        # reset the marks (only those set)
+        if small_n:
+            for j in range(n):
+                seen[j] = False
+        else:
+            for jj in range(m):
+                seen[idx[jj]] = False
+            m0 = _window(y, LA, lam, g, radius, n, K, 0.0, 3, idx)
+            for jj in range(m0):
+                seen[idx[jj]] = False
         if hit_k >= 0:
             s_hit = s + hit_s
             flight_state(y0, LA, lam, g, s_hit, y)
@@ -221,12 +281,20 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
                     break
                 s_hit += corr
                 flight_state(y0, LA, lam, g, s_hit, y)
-            # simultaneous: another approaching vertex within the time resolution
+            # simultaneous: another approaching vertex within the time resolution (only
+            # vertices in the window around the lowest direction can be touching)
             gk0, rk0, ak0, nk0 = vertex_jet(y, LA, lam, g, pts[hit_k, 0], pts[hit_k, 1])
             tres0 = (nk0 + 1e-300) / max(-rk0, 1e-300)
+            if small_n:
+                m = n
+                for j in range(n):
+                    idx[j] = j
+            else:
+                m = _window(y, LA, lam, g, radius, n, K, 0.0, 3, idx)
             n_sim = 1
             k2 = -1
-            for k in range(n):
+            for jj in range(m):
+                k = idx[jj]
                 if k == hit_k:
                     continue
                 gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
@@ -240,6 +308,7 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
         if land_k >= 0:
             out_y[:] = y
             return s, land_k, it, 1, -1, 1
+        step = min(step, cap_step)
         step = max(step, 1e-15 * max(s, 1e-300))
         if s + step >= horizon:
             out_y[:] = y
