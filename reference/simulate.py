@@ -24,8 +24,9 @@ impulse as the completion (−m u + 2 m u / (1 − γ) = m u (1 + γ) / (1 − �
 effective mass), only spread over that window, so the completion changes the state at
 the accumulation time by O((u / V)²) relative: (chatter_tol)² = 1e-12 for the default
 1e-6.  Bounces lower than the gap's roundoff band (u < 4 √(2 |a_n| ε z)) cannot be
-resolved one by one at all; completion always takes over there.  tests/test_reference_chatter.py measures it against a run that
-resolves the impacts one by one until they are below roundoff.
+resolved one by one at all; completion always takes over there.
+tests/test_reference_chatter.py measures it against a run that resolves the impacts one
+by one down to that floor.
 """
 
 from __future__ import annotations
@@ -408,7 +409,7 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
             # output and stop there (counted: the bound should make this rare)
             run.stats["horizon_backstops"] = run.stats.get("horizon_backstops", 0) + 1
 
-            def min_gap(s):
+            def min_gap(s, sol=sol, crossed=crossed):
                 return min(model.contacts(sol(s))[0][k] for k in crossed)
 
             s_star = brentq(min_gap, 0.0, h, xtol=1e-15 * h, rtol=4 * np.finfo(float).eps)
@@ -421,7 +422,7 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
         if np.any(lam_new < 0):
             i = int(np.argmin(lam_new))
 
-            def lam_i(s, i=i):
+            def lam_i(s, i=i, sol=sol):
                 return contact_forces(model, sol(s), active)[i]
 
             s_star = brentq(lam_i, 0.0, h, xtol=1e-15 * h, rtol=4 * np.finfo(float).eps)
