@@ -73,9 +73,22 @@ def solve_contact_lcp(
     return active, np.array([lam[i] for i in S if lam[i] > 0.0])
 
 
-def constrained_rhs(model: BodyModel, contacts: list[int]):
+def constrained_rhs(model: BodyModel, contacts: list[int], compiled: bool = True):
     """dy/dt with the contacts held as bilateral constraints (forces may go negative:
-    that is the lift-off signal)."""
+    that is the lift-off signal).  Flat ground with one or two contacts uses the
+    compiled closed form (reference.flight_kernel.constrained_rhs_flat)."""
+    if compiled and model.flat and 1 <= len(contacts) <= 2:
+        from .flight_kernel import constrained_rhs_flat
+
+        held = np.ascontiguousarray(model.points[list(contacts)])
+        m, i1, i3, g = model.mass, model.i1, model.i3, model.gravity
+
+        def rhs_fast(_t: float, y: np.ndarray) -> np.ndarray:
+            dy = np.empty(13)
+            constrained_rhs_flat(y, held, m, i1, i3, g, dy)
+            return dy
+
+        return rhs_fast
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
         A, b, J, Minv, acc_free = contact_system(model, y, contacts)
@@ -160,7 +173,7 @@ def chunk_horizon(model: BodyModel, y: np.ndarray, contacts: list[int], others_j
     """Largest safe chunk: no other contact can reach the ground (quadratic lower bound
     with K = 2 max(|g″|) + g, a factor-2 margin on the current second derivatives), and
     the chunk stays short against the local time scale √(length / acceleration)."""
-    from .events import first_root_lower_bound
+    from .flight_kernel import safe_step
 
     g = model.gravity
     acc_scale = float(np.max(np.abs(others_jet.accel))) if len(others_jet.accel) else 0.0
@@ -170,7 +183,7 @@ def chunk_horizon(model: BodyModel, y: np.ndarray, contacts: list[int], others_j
         if k in contacts:
             continue
         gk = max(others_jet.gap[k], others_jet.noise[k])
-        d = first_root_lower_bound(gk, others_jet.rate[k], others_jet.accel[k], K, 0.0)
+        d = safe_step(gk, others_jet.rate[k], others_jet.accel[k], K, 0.0)
         h = min(h, d)
     L = model.length_scale(y)
     T_local = math.sqrt(max(L, 1e-300) / K)

@@ -484,3 +484,80 @@ def bounce_loop(
         imp[n_imp, 5] = u_post
         n_imp += 1
         ns = _record_sample(y, t_hi, t_lo, mass, i1, i3, g, st, sy, se, ns)
+
+
+# ------------------------------------------------------------------ contact-phase RHS
+
+
+@njit(cache=True)
+def constrained_rhs_flat(y, held_pts, mass, i1, i3, g, dy):
+    """dy/dt with 1 or 2 vertices held on flat ground (reference.contact.constrained_rhs
+    for n = e_z): a_n = A λ + b = 0 solved in closed form for m ≤ 2.  Returns λ."""
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    e3x = 2 * (x * z + w * yq)
+    e3y = 2 * (yq * z - w * x)
+    e3z = 1 - 2 * (x * x + yq * yq)
+    wx, wy, wz = y[10], y[11], y[12]
+    w3 = wx * e3x + wy * e3y + wz * e3z
+    # L = I ω, gyroscopic −I⁻¹(ω × Iω)
+    Lx = i1 * wx + (i3 - i1) * w3 * e3x
+    Ly = i1 * wy + (i3 - i1) * w3 * e3y
+    Lz = i1 * wz + (i3 - i1) * w3 * e3z
+    gx = wy * Lz - wz * Ly
+    gy = wz * Lx - wx * Lz
+    gz = wx * Ly - wy * Lx
+    f = 1.0 / i3 - 1.0 / i1
+    eg = e3x * gx + e3y * gy + e3z * gz
+    ax0 = -(gx / i1 + f * eg * e3x)
+    ay0 = -(gy / i1 + f * eg * e3y)
+    az0 = -(gz / i1 + f * eg * e3z)
+    m = held_pts.shape[0]
+    cxs = np.empty(2)
+    cys = np.empty(2)
+    icx = np.empty(2)
+    icy = np.empty(2)
+    icz = np.empty(2)
+    b = np.empty(2)
+    for i in range(m):
+        px, py = held_pts[i, 0], held_pts[i, 1]
+        rx = (1 - 2 * (yq * yq + z * z)) * px + 2 * (x * yq - w * z) * py
+        ry = 2 * (x * yq + w * z) * px + (1 - 2 * (x * x + z * z)) * py
+        rz = 2 * (x * z - w * yq) * px + 2 * (yq * z + w * x) * py
+        cx, cy = ry, -rx  # r × e_z
+        ec = e3x * cx + e3y * cy
+        cxs[i], cys[i] = cx, cy
+        icx[i] = cx / i1 + f * ec * e3x
+        icy[i] = cy / i1 + f * ec * e3y
+        icz[i] = f * ec * e3z
+        # b = −g + c·ω̇_free + (ω·r) ω_z − |ω|² r_z
+        b[i] = (
+            -g
+            + cx * ax0
+            + cy * ay0
+            + (wx * rx + wy * ry + wz * rz) * wz
+            - (wx * wx + wy * wy + wz * wz) * rz
+        )
+    lam0 = 0.0
+    lam1 = 0.0
+    if m == 1:
+        A00 = 1.0 / mass + cxs[0] * icx[0] + cys[0] * icy[0]
+        lam0 = -b[0] / A00
+    else:
+        A00 = 1.0 / mass + cxs[0] * icx[0] + cys[0] * icy[0]
+        A11 = 1.0 / mass + cxs[1] * icx[1] + cys[1] * icy[1]
+        A01 = 1.0 / mass + cxs[0] * icx[1] + cys[0] * icy[1]
+        det = A00 * A11 - A01 * A01
+        lam0 = (-b[0] * A11 + b[1] * A01) / det
+        lam1 = (-b[1] * A00 + b[0] * A01) / det
+    dy[0], dy[1], dy[2] = y[7], y[8], y[9]
+    dy[3] = 0.5 * (-wx * x - wy * yq - wz * z)
+    dy[4] = 0.5 * (wx * w + wy * z - wz * yq)
+    dy[5] = 0.5 * (-wx * z + wy * w + wz * x)
+    dy[6] = 0.5 * (wx * yq - wy * x + wz * w)
+    dy[7] = 0.0
+    dy[8] = 0.0
+    dy[9] = -g + (lam0 + lam1) / mass
+    dy[10] = ax0 + icx[0] * lam0 + (icx[1] * lam1 if m == 2 else 0.0)
+    dy[11] = ay0 + icy[0] * lam0 + (icy[1] * lam1 if m == 2 else 0.0)
+    dy[12] = az0 + icz[0] * lam0 + (icz[1] * lam1 if m == 2 else 0.0)
+    return lam0
