@@ -127,6 +127,8 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--executor", choices=("local", "dask"), default="local")
     e.add_argument("--scheduler")
     e.add_argument("--workers", type=int)
+    e.add_argument("--t-end", type=_positive_float, help="cap the run length (non-linear engines)")
+    e.add_argument("--chunk-size", type=int, help="runs per task (default 25 linear, 1 others)")
     e.add_argument("--out", required=True)
     e.add_argument("--json", action="store_true")
 

@@ -412,7 +412,7 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
             def min_gap(s, sol=sol, crossed=crossed):
                 return min(model.contacts(sol(s))[0][k] for k in crossed)
 
-            s_star = brentq(min_gap, 0.0, h, xtol=1e-15 * h, rtol=4 * np.finfo(float).eps)
+            s_star = _first_zero(min_gap, h)
             y, _, nfev = integrate_chunk(model, y, active, s_star, run.opts.contact_rtol)
             _sample_grid(run, sol, s_star)
             run.clock.add(s_star)
@@ -425,7 +425,7 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
             def lam_i(s, i=i, sol=sol):
                 return contact_forces(model, sol(s), active)[i]
 
-            s_star = brentq(lam_i, 0.0, h, xtol=1e-15 * h, rtol=4 * np.finfo(float).eps)
+            s_star = _first_zero(lam_i, h)
             if s_star > 0:
                 y, _, nfev = integrate_chunk(model, y, active, s_star, run.opts.contact_rtol)
                 run.stats["contact_rhs_evals"] += nfev
@@ -449,6 +449,18 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
             run.sample(y)
             _close_contact_phase(run, t0, active, E_start, y)
             return None
+
+
+def _first_zero(f, h: float) -> float:
+    """Root of f on [0, h] (brentq); 0 when f(0) ≤ 0 already (a force that is zero or
+    pulling at the start of the chunk lifts off at once); h when the dense output has
+    not crossed yet at h (the projected end state has: the crossing is within the
+    interpolation error of the chunk end)."""
+    if f(0.0) <= 0.0:
+        return 0.0
+    if f(h) >= 0.0:
+        return h
+    return brentq(f, 0.0, h, xtol=1e-15 * h, rtol=4 * np.finfo(float).eps)
 
 
 def _close_contact_phase(run: _Run, t0, active, E_start, y) -> None:

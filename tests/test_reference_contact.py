@@ -106,3 +106,14 @@ def test_contact_phase_keeps_energy_and_constraints():
         y = np.r_[traj.position[i], traj.quaternion[i], traj.velocity[i], traj.angular_velocity[i]]
         g = model.contacts(y)[0][0]
         assert abs(g) < 1e-12  # dense-output samples inside chunks; chunk ends are projected
+
+
+def test_gamma_zero_heavy_rim_triangle_reaches_the_singularity():
+    """Regression (sweep at ρ = 1, γ = 0): a contact force that is already pulling at a
+    chunk start, or crosses zero only in the projected end state, is a lift-off, not a
+    root-finding failure.  The run must end in a decided state with energy exhausted."""
+    q = (-0.0004465939407552824, 0.000480321018228262, 1.0)
+    p = (-0.03882222191615614, 0.03983622205983048, -1.0)
+    traj = simulate(make_scene(n=3, rho=1.0, gamma=0.0, q=q, p=p, t_end=200.0))
+    assert traj.status.value == "singularity"
+    assert traj.t_singularity is not None and traj.t_singularity > traj.impacts[-1].t - 1e-9

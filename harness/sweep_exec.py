@@ -1,0 +1,176 @@
+"""Executors for sweep chunks: a local process pool (default) or a Dask cluster.
+
+Both run `harness.sweep_run.run_chunk` on plain-data chunks and yield (chunk, rows) as
+chunks finish, in completion order, with at most a few chunks per worker in flight so
+that memory stays flat and an interrupt stops quickly.  Results do not depend on the
+executor: every task's initial state comes from its own seed (sweep_grid).
+
+Failures: a run that raises is caught inside the chunk (a `failed` row with its error).
+A chunk that fails as a whole (a worker process died, e.g. a segfault in an engine) is
+retried once; if it fails again it is split into single runs, each retried once, and a
+single run that still fails is recorded as `failed` with the error.  A broken local pool
+is replaced by a new one, and on the local pool a retry runs alone (nothing else in
+flight), so that the chunks that merely shared the broken pool are not blamed twice.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+import time
+from collections import deque
+from collections.abc import Iterator
+
+from .sweep_grid import Chunk
+from .sweep_run import failed_rows, run_chunk
+
+MAX_ATTEMPTS = 2
+
+
+class ExecutorError(Exception):
+    """The executor cannot start (e.g. no scheduler at the given address)."""
+
+
+def _exit_with_parent(parent_pid: int) -> None:
+    """Worker initializer: exit when the parent dies (e.g. SIGKILL), so no orphan keeps
+    computing after the sweep is gone."""
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent_pid:
+                os._exit(1)
+            time.sleep(0.5)
+
+    threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
+
+
+class _Work:
+    __slots__ = ("chunk", "attempts")
+
+    def __init__(self, chunk: Chunk, attempts: int = 0):
+        self.chunk, self.attempts = chunk, attempts
+
+
+def _after_failure(work: _Work, exc: BaseException, queue: deque):
+    """Requeue a failed chunk (retry, or split into single runs); return rows to record
+    when it has failed for good, else None."""
+    work.attempts += 1
+    if work.attempts < MAX_ATTEMPTS:
+        queue.appendleft(work)
+        return None
+    ch = work.chunk
+    if len(ch.samples) > 1:
+        for s in reversed(ch.samples):
+            queue.appendleft(_Work(Chunk(ch.config, ch.i_gamma, ch.i_rho, (s,))))
+        return None
+    return failed_rows(ch, f"worker failed: {type(exc).__name__}: {exc}")
+
+
+def run_local(
+    chunks: list[Chunk], workers: int | None = None, fn=run_chunk
+) -> Iterator[tuple[Chunk, list[dict]]]:
+    """Chunks on a process pool of `workers` processes (default: all cores)."""
+    import multiprocessing as mp
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    workers = workers or os.cpu_count() or 1
+    methods = mp.get_all_start_methods()
+    ctx = mp.get_context("fork" if "fork" in methods else "spawn")
+
+    def new_pool():
+        return ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=ctx,
+            initializer=_exit_with_parent,
+            initargs=(os.getpid(),),
+        )
+
+    queue = deque(_Work(c) for c in chunks)
+    limit = 2 * workers + 1
+    pool = new_pool()
+    inflight: dict = {}
+    try:
+        while queue or inflight:
+            while queue and len(inflight) < limit:
+                # a retry runs alone, so that a crash during it is its own
+                if any(x.attempts for x, _ in inflight.values()):
+                    break
+                if queue[0].attempts and inflight:
+                    break
+                w = queue.popleft()
+                try:
+                    inflight[pool.submit(fn, w.chunk)] = (w, pool)
+                except BrokenProcessPool:
+                    queue.appendleft(w)
+                    pool.shutdown(wait=False, cancel_futures=True)
+                    pool = new_pool()
+            done, _ = wait(list(inflight), return_when=FIRST_COMPLETED)
+            for fut in done:
+                w, p = inflight.pop(fut)
+                try:
+                    rows = fut.result()
+                except Exception as exc:
+                    if isinstance(exc, BrokenProcessPool) and p is pool:
+                        pool.shutdown(wait=False, cancel_futures=True)
+                        pool = new_pool()
+                    rows = _after_failure(w, exc, queue)
+                    if rows is None:
+                        continue
+                yield w.chunk, rows
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+
+
+def run_dask(
+    chunks: list[Chunk], scheduler: str, fn=run_chunk
+) -> Iterator[tuple[Chunk, list[dict]]]:
+    """Chunks on a dask.distributed cluster at `scheduler` (e.g. tcp://host:8786).
+
+    The workers must be able to import this package (`harness`, `reference`): install
+    it on every worker's Python.  Results come back to this process, which alone writes
+    the store, so the workers need no access to --out.  The cluster's own size decides
+    the parallelism (--workers is for the local pool only)."""
+    from distributed import Client
+
+    try:
+        client = Client(scheduler, timeout="20s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ExecutorError(f"cannot connect to the Dask scheduler at {scheduler}: {exc}") from None
+    return _dask_results(client, chunks, fn)
+
+
+def _dask_results(client, chunks: list[Chunk], fn) -> Iterator[tuple[Chunk, list[dict]]]:
+    from distributed import as_completed
+
+    try:
+        n_workers = max(
+            1, sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
+        )
+        limit = 2 * n_workers + 1
+        queue = deque(_Work(c) for c in chunks)
+        inflight: dict = {}
+        ac = as_completed()
+
+        def submit(w: _Work) -> None:
+            fut = client.submit(fn, w.chunk, pure=False, retries=0)
+            inflight[fut.key] = w
+            ac.add(fut)
+
+        while queue and len(inflight) < limit:
+            submit(queue.popleft())
+        while inflight:
+            fut = next(ac)
+            w = inflight.pop(fut.key)
+            try:
+                rows = fut.result()
+            except Exception as exc:
+                rows = _after_failure(w, exc, queue)
+            finally:
+                fut.release()
+            if rows is not None:
+                yield w.chunk, rows
+            while queue and len(inflight) < limit:
+                submit(queue.popleft())
+    finally:
+        client.close()
