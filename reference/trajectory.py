@@ -15,7 +15,7 @@ normal impulse and the pre/post normal velocities of the contact point.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 from typing import Any
 
 import numpy as np
@@ -23,7 +23,7 @@ import numpy as np
 from . import quaternion as qt
 
 
-class Status(str, Enum):
+class Status(StrEnum):
     T_END = "t_end"  # reached the requested end time
     SINGULARITY = "singularity"  # all contacts down: energy exhausted (t_singularity set)
     SIMULTANEOUS_IMPACT = "simultaneous_impact"  # undecidable in this model: stopped
