@@ -311,6 +311,7 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
         step = min(step, cap_step)
         step = max(step, 1e-15 * max(s, 1e-300))
         if s + step >= horizon:
+            flight_state(y0, LA, lam, g, horizon, y)
             out_y[:] = y
             return horizon, -1, it, 0, -1, 0
         s += step

@@ -202,3 +202,23 @@ def test_trajectory_summary_of_a_linear_run():
 def test_max_impacts_stops_the_run():
     run = run_linear(LinearModel.polygon(5, 0.5, 0.9), (0.01, 0, 0.05), (0, 0, -0.1), max_impacts=7)
     assert run.status is Status.MAX_IMPACTS and run.n_impacts == 7
+
+
+@pytest.mark.parametrize("name", ["pentagon-bounce", "triangle-chatter", "three-point-disk"])
+def test_grid_samples_inside_a_phase_keep_the_linear_energy(name):
+    """Regression: grid samples are evaluated on each segment's quadratic with that
+    segment's acceleration (−g u3, or a_contact when held), so the linear energy
+    ½pᵀΘp + m g h is constant between events to roundoff."""
+    import numpy as np
+
+    from harness.scenes import resolve_scene
+
+    t = simulate_linear(resolve_scene(name), t_end=1.0)
+    events = np.array([p.t_start for p in t.phases] + [p.t_end for p in t.phases])
+    worst = 0.0
+    for i in range(len(t.t) - 1):
+        a, b = t.t[i], t.t[i + 1]
+        if np.any((events >= a - 1e-15) & (events <= b + 1e-15)):
+            continue
+        worst = max(worst, abs(t.energy[i + 1] - t.energy[i]))
+    assert worst <= 1e-14 * t.energy[0]

@@ -89,6 +89,24 @@ _REASONS = {
 }
 
 
+def _segment_accelerations(model: LinearModel, held: np.ndarray) -> np.ndarray:
+    """The constant acceleration after each event, from its held contacts (eq.
+    pacccontact; free fall −g u3 when none): a function of the held set alone, so it is
+    recomputed in true units rather than converted from the kernel's normalised value
+    (whose scale may change between writing a row and setting its acceleration)."""
+    from .model import held_acceleration
+
+    acc = np.empty((len(held), 3))
+    cache: dict[tuple[int, ...], np.ndarray] = {}
+    for i, row in enumerate(held):
+        key = tuple(int(c) for c in row if c >= 0)
+        if key not in cache:
+            f = model.F[list(key)] if key else np.zeros((0, 3))
+            cache[key] = held_acceleration(f, model.theta, model.mass, model.gravity)[0]
+        acc[i] = cache[key]
+    return acc
+
+
 def run_linear(
     model: LinearModel,
     q0,
@@ -154,7 +172,7 @@ def run_linear(
             p_pre=np.ldexp(S[:, 3:6], ev),
             q_post=np.ldexp(S[:, 6:9], eq),
             p_post=np.ldexp(S[:, 9:12], ev),
-            acc=np.ldexp(S[:, 12:15], 2 * ev - eq),
+            acc=_segment_accelerations(model, oi[:, [K.I_HELD1, K.I_HELD2]]),
         )
     else:
         states = dict(q_pre=None, p_pre=None, q_post=None, p_post=None, acc=None)
