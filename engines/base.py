@@ -15,7 +15,7 @@ inactive in the previous step.  Its
   contact goes inactive (the compression + restitution phase), capped by a time window
   so that a sustained contact does not count as one long impact;
 - pre/post normal velocities are the contact point's normal velocity in the last row
-  before the contact went active and in the last active row of that window.
+  before the contact went active and its largest value over that window (+1 row).
 """
 
 from __future__ import annotations
@@ -88,8 +88,9 @@ def impacts_from_contact_activity(
     gap may already be ≤ 0 at the onset row: the zero crossing is searched up to two
     intervals back).  The impact window ends when the contact goes inactive, when its
     normal velocity stops increasing, or after `max_impact_time` (default: 50 steps or
-    0.05 s, whichever is longer: soft default contacts last ~0.02 s); v⁺ is read at the
-    last active row of the window."""
+    0.05 s, whichever is longer: soft default contacts last ~0.02 s); v⁺ is the largest
+    normal velocity over the window and the row after it (engines book the impulse on
+    the row before or after the step that applies it; the bounce peaks either way)."""
     active = impulses > 0.0
     events: list[ImpactEvent] = []
     n_steps, n_contacts = impulses.shape
@@ -117,6 +118,10 @@ def impacts_from_contact_activity(
                 total += impulses[i, k]
                 last = i
                 i += 1
+            # v⁺: the largest normal velocity over the window and the row after it (the
+            # bounce peaks there whichever row an engine books the impulse on)
+            hi_row = min(last + 1, n_steps - 1)
+            post_row = j + int(np.argmax(vn[j : hi_row + 1, k]))
             pre_row = max(j - 1, 0)
             for r in (j - 1, j - 2):  # the last row that was still approaching freely
                 if r >= 0 and not active[r, k]:
@@ -128,7 +133,7 @@ def impacts_from_contact_activity(
                     contact=int(k),
                     impulse=float(total),
                     v_normal_pre=float(vn[pre_row, k]),
-                    v_normal_post=float(vn[last, k]),
+                    v_normal_post=float(vn[post_row, k]),
                 )
             )
     events.sort(key=lambda e: (e.t, e.contact))
