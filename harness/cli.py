@@ -213,8 +213,11 @@ def cmd_compare(args) -> int:
     if args.record:
         from .recording import record_trajectories
 
-        trajs = [result.reference] + [r.trajectory for r in result.runs]
-        path = record_trajectories(trajs, args.record, scene=scene)
+        runs = [r.trajectory for r in result.runs if r.trajectory.n_samples > 0]
+        skipped = len(result.runs) - len(runs)
+        if skipped:
+            log(f"recording leaves out {skipped} run(s) that produced no samples")
+        path = record_trajectories([result.reference, *runs], args.record, scene=scene)
         log(f"wrote {path}")
     emit(_finite(result.to_dict()), args.json, format_compare(result))
     return 0
