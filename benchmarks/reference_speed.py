@@ -114,7 +114,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--only", action="append", help="case names (default: all)")
-    ap.add_argument("--profile", action="store_true", help="cProfile n = 3 and n = 10,000 (both families)")
+    ap.add_argument(
+        "--profile", action="store_true", help="cProfile n = 3 and n = 10,000 (both families)"
+    )
     ap.add_argument("--json", metavar="FILE")
     args = ap.parse_args(argv)
     all_cases = cases()

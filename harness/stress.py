@@ -30,12 +30,14 @@ penetration above the simulator's tolerance, `TOLERANCES`; any missed or spuriou
 impact), else `ok`; the reasons are listed.  A run whose predicted cost exceeds the
 per-run budget is not run: verdict `skipped (budget)` with the prediction (engines: two
 short pilot runs give the setup and per-step cost; the reference: a pilot over a tenth
-of the case).
+of the case); an engine or linear run still going at twice the budget is stopped (it
+runs in a forked child process) and reported the same way.
 """
 
 from __future__ import annotations
 
 import math
+import multiprocessing
 import os
 import time
 from collections.abc import Callable, Sequence
@@ -71,6 +73,9 @@ FAILED_PENETRATION = 0.5
 TOLERANCES = {"reference": (1e-9, 1e-9), "approximate": (1e-3, 1e-2)}
 # Engines: runs longer than this many steps are predicted from pilots first.
 PILOT_FREE_STEPS = 5000
+# Engines and the linear model run in a child process stopped at this × the budget
+# (pilot predictions miss contact-heavy later phases: measured up to 10x+ too low).
+HARD_CAP_FACTOR = 2.0
 PILOT_STEPS = (200, 2000)
 # Reference: pilot over this fraction of t_end and of max_impacts.
 REFERENCE_PILOT_FRACTION = 0.1
@@ -473,7 +478,9 @@ def predict_engine_time(engine: str, scene: Scene, dt: float) -> float | None:
     return max(t_short - c * short, 0.0) + c * steps
 
 
-def _skipped_row(case: StressCase, engine: str, dt, predicted: float, budget: float, note=""):
+def _skipped_row(
+    case: StressCase, engine: str, dt, predicted: float | None, reason: str
+) -> dict[str, Any]:
     return {
         "case": case.name,
         "engine": engine,
@@ -488,8 +495,48 @@ def _skipped_row(case: StressCase, engine: str, dt, predicted: float, budget: fl
         "spurious_impacts": None,
         "predicted_wall_time_s": predicted,
         "wall_time_s": None,
-        "reason": f"predicted {predicted:.3g} s > budget {budget:g} s" + note,
+        "reason": reason,
     }
+
+
+def _over_budget(predicted: float, budget: float) -> str:
+    return f"predicted {predicted:.3g} s > budget {budget:g} s"
+
+
+def run_capped(fn: Callable[[], Any], cap_s: float) -> tuple[Any, str | None]:
+    """fn() in a forked child process, stopped after cap_s seconds of wall time.
+
+    Returns (result, None) when it answered, (None, None) when it was stopped at the
+    cap (the child, and only it, is terminated by its pid), and (None, message) when
+    it died without answering (a crash inside an engine).  An exception inside fn is
+    fn's business: it should return it as data."""
+    ctx = multiprocessing.get_context("fork")
+    recv, send = ctx.Pipe(duplex=False)
+
+    def child() -> None:
+        send.send(fn())
+        send.close()
+
+    proc = ctx.Process(target=child, daemon=True)
+    proc.start()
+    send.close()
+    try:
+        if recv.poll(cap_s):
+            try:
+                out = recv.recv()
+            except EOFError:
+                proc.join()
+                return None, f"simulator process died (exit code {proc.exitcode})"
+            proc.join()
+            return out, None
+        proc.terminate()
+        proc.join(5.0)
+        if proc.is_alive():
+            proc.kill()
+            proc.join()
+        return None, None
+    finally:
+        recv.close()
 
 
 def _engine_row(
@@ -513,13 +560,30 @@ def _engine_row(
         except Exception:  # the run itself will report the failure
             predicted = None
         if predicted is not None and predicted > budget_s:
-            return _skipped_row(case, engine, step, predicted, budget_s)
-    traj, wall, err = _timed(lambda: run_simulator(engine, scene, step, t_end))
-    if traj is None:
+            return _skipped_row(case, engine, step, predicted, _over_budget(predicted, budget_s))
+
+    def judged_run() -> dict[str, Any]:
+        traj, wall, err = _timed(lambda: run_simulator(engine, scene, step, t_end))
+        if traj is None:
+            from .bench import failed_trajectory
+
+            traj = failed_trajectory(engine, scene, step, err or "")
+        return {**assess(traj, ref, scene, t_end, error=err), "wall_time_s": wall}
+
+    cap = HARD_CAP_FACTOR * budget_s
+    row, crashed = run_capped(judged_run, cap)
+    if row is None and crashed is None:
+        guess = "not predicted" if predicted is None else f"predicted {predicted:.3g} s"
+        why = f"stopped at the hard cap of {cap:g} s ({guess}, budget {budget_s:g} s)"
+        skipped = _skipped_row(case, engine, step, predicted, why)
+        skipped["wall_time_s"] = cap
+        return skipped
+    if row is None:  # the child died without an answer (e.g. a segfault in the engine)
         from .bench import failed_trajectory
 
-        traj = failed_trajectory(engine, scene, step, err or "")
-    row = assess(traj, ref, scene, t_end, error=err)
+        traj = failed_trajectory(engine, scene, step, crashed or "")
+        row = {**assess(traj, ref, scene, t_end, error=crashed), "wall_time_s": None}
+    wall = row.pop("wall_time_s")
     if ref_partial and row["missed_impacts"] is not None:
         note = (
             f"compared with the reference's first {len(ref.impacts)} impacts "
@@ -568,7 +632,9 @@ def stress(
                     f"; ran the first {len(ref.impacts)} impacts (t <= {ref.t_final:.6g}) "
                     "as the basis for the engines"
                 )
-                row = _skipped_row(case, engine, None, ref_pred, budget_s, note)
+                row = _skipped_row(
+                    case, engine, None, ref_pred, _over_budget(ref_pred, budget_s) + note
+                )
             elif engine == "reference":
                 row = assess(ref, ref, case.scene, case.scene.run.t_end, exact=True)
                 row = {"case": case.name, "engine": engine, "dt": None, **row}

@@ -171,3 +171,27 @@ def test_real_tiny_case_gives_contract_rows(monkeypatch):
     (row,) = doc["cases"]
     assert row["verdict"] == S.SKIPPED and "budget" in row["reason"]
     assert "skipped" in S.format_stress(doc)
+
+
+def test_run_past_the_hard_cap_is_stopped_and_reported(monkeypatch):
+    import time
+
+    def slow(*args, **kwargs):
+        time.sleep(30.0)
+
+    monkeypatch.setattr(S, "predict_engine_time", lambda *a: None)
+    monkeypatch.setattr(S, "run_simulator", slow)
+    start = time.perf_counter()
+    doc = S.stress(engines=["mujoco"], cases=["grazing"], budget_s=0.3)
+    assert time.perf_counter() - start < 10.0
+    (row,) = doc["cases"]
+    assert row["verdict"] == S.SKIPPED and "hard cap" in row["reason"]
+
+
+def test_engine_process_dying_is_a_failed_run(monkeypatch):
+    import os
+
+    monkeypatch.setattr(S, "predict_engine_time", lambda *a: None)
+    monkeypatch.setattr(S, "run_simulator", lambda *a, **k: os._exit(3))
+    (row,) = S.stress(engines=["mujoco"], cases=["grazing"])["cases"]
+    assert row["verdict"] == "failed" and "exit code 3" in row["reason"]
