@@ -6,7 +6,8 @@
 - near-simultaneous: a square falling without rotation, tilted so that vertex 1 is
   DT_APART·|v| higher than vertex 0: the two hit DT_APART ≈ 1e-12 s apart.
 
-Run: python scripts/make_scenes.py  (rewrites harness/scenes/{grazing-contact,near-simultaneous}.toml)
+Run: python scripts/make_scenes.py
+(rewrites harness/scenes/{grazing-contact,near-simultaneous}.toml)
 """
 
 from __future__ import annotations

@@ -35,7 +35,9 @@ def test_three_point_ground_keeps_spin_about_the_face_normal():
     scene = resolve_scene("three-point-disk")
     traj = simulate(scene)
     assert len(traj.impacts) > 10
-    w3 = np.array([w @ qt.body_axis(q) for w, q in zip(traj.angular_velocity, traj.quaternion)])
+    w3 = np.array(
+        [w @ qt.body_axis(q) for w, q in zip(traj.angular_velocity, traj.quaternion, strict=True)]
+    )
     scale = np.max(np.linalg.norm(traj.angular_velocity, axis=1))
     assert np.max(np.abs(w3 - w3[0])) <= 1e-12 * scale
 
