@@ -98,11 +98,13 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--json", action="store_true")
     b.add_argument("--plot", metavar="FILE.png")
     b.add_argument("--out", metavar="FILE.json")
+    b.add_argument("--budget", type=_positive_float, default=60.0, help="seconds per setting")
 
     st = sub.add_parser("stress", help="hard-case suite, a verdict per case and engine")
     st.add_argument("--engine", action="append")
     st.add_argument("--case", action="append")
     st.add_argument("--dt", type=_positive_float)
+    st.add_argument("--budget", type=_positive_float, default=30.0, help="seconds per run")
     st.add_argument("--json", action="store_true")
 
     a = sub.add_parser("analyze", help="analyses of the linearised model")
@@ -235,6 +237,7 @@ def cmd_bench(args) -> int:
         repeats=args.repeats,
         plot=args.plot,
         progress=log,
+        budget_s=args.budget,
     )
     if args.out:
         Path(args.out).write_text(json.dumps(_finite(doc), indent=1))
@@ -245,7 +248,9 @@ def cmd_bench(args) -> int:
 def cmd_stress(args) -> int:
     from .stress import format_stress, stress
 
-    doc = stress(engines=args.engine, cases=args.case, dt=args.dt, progress=log)
+    doc = stress(
+        engines=args.engine, cases=args.case, dt=args.dt, progress=log, budget_s=args.budget
+    )
     emit(_finite(doc), args.json, format_stress(doc))
     return 0
 
