@@ -101,27 +101,10 @@ def timed(setting: Setting, scene: Scene, t_end: float) -> tuple[Trajectory, flo
     except SceneError:
         raise
     except Exception as exc:  # a broken simulator is a result
-        traj = failed_trajectory(setting.engine, scene, setting.dt, f"{type(exc).__name__}: {exc}")
+        traj = Trajectory.failed(
+            setting.engine, scene.name, setting.dt, f"{type(exc).__name__}: {exc}"
+        )
     return traj, time.perf_counter() - start
-
-
-def failed_trajectory(engine: str, scene: Scene, dt: float | None, message: str) -> Trajectory:
-    z3 = np.zeros((0, 3))
-    return Trajectory(
-        engine=engine,
-        scene=scene.name,
-        t=np.zeros(0),
-        position=z3,
-        quaternion=np.zeros((0, 4)),
-        velocity=z3,
-        angular_velocity=z3,
-        kinetic_energy=np.zeros(0),
-        potential_energy=np.zeros(0),
-        impacts=[],
-        status=Status.FAILED,
-        message=message,
-        dt=dt,
-    )
 
 
 def predict_time(measured: Sequence[tuple[float, float]], dt: float) -> float:

@@ -113,27 +113,8 @@ def _timed_run(
     except Exception as exc:  # an engine that breaks is a result, not a crash
         if reraise:
             raise
-        traj = _failed_trajectory(engine, scene, dt, f"{type(exc).__name__}: {exc}")
+        traj = Trajectory.failed(engine, scene.name, dt, f"{type(exc).__name__}: {exc}")
     return traj, time.perf_counter() - start
-
-
-def _failed_trajectory(engine: str, scene: Scene, dt: float | None, message: str) -> Trajectory:
-    empty3 = np.zeros((0, 3))
-    return Trajectory(
-        engine=engine,
-        scene=scene.name,
-        t=np.zeros(0),
-        position=empty3,
-        quaternion=np.zeros((0, 4)),
-        velocity=empty3,
-        angular_velocity=empty3,
-        kinetic_energy=np.zeros(0),
-        potential_energy=np.zeros(0),
-        impacts=[],
-        status=Status.FAILED,
-        message=message,
-        dt=dt,
-    )
 
 
 def _progress_line(engine: str, dt: float | None, traj: Trajectory, wall: float) -> str:

@@ -565,9 +565,7 @@ def _engine_row(
     def judged_run() -> dict[str, Any]:
         traj, wall, err = _timed(lambda: run_simulator(engine, scene, step, t_end))
         if traj is None:
-            from .bench import failed_trajectory
-
-            traj = failed_trajectory(engine, scene, step, err or "")
+            traj = Trajectory.failed(engine, scene.name, step, err or "")
         return {**assess(traj, ref, scene, t_end, error=err), "wall_time_s": wall}
 
     cap = HARD_CAP_FACTOR * budget_s
@@ -579,9 +577,7 @@ def _engine_row(
         skipped["wall_time_s"] = cap
         return skipped
     if row is None:  # the child died without an answer (e.g. a segfault in the engine)
-        from .bench import failed_trajectory
-
-        traj = failed_trajectory(engine, scene, step, crashed or "")
+        traj = Trajectory.failed(engine, scene.name, step, crashed or "")
         row = {**assess(traj, ref, scene, t_end, error=crashed), "wall_time_s": None}
     wall = row.pop("wall_time_s")
     if ref_partial and row["missed_impacts"] is not None:

@@ -81,6 +81,26 @@ class Trajectory:
     t_lo: np.ndarray | None = None
     dt: float | None = None  # fixed timestep of an engine run, None for event-driven
 
+    @classmethod
+    def failed(cls, engine: str, scene: str, dt: float | None, message: str) -> Trajectory:
+        """An empty run with status `failed`: what a simulator that raised produced."""
+        empty3 = np.zeros((0, 3))
+        return cls(
+            engine=engine,
+            scene=scene,
+            t=np.zeros(0),
+            position=empty3,
+            quaternion=np.zeros((0, 4)),
+            velocity=empty3,
+            angular_velocity=empty3,
+            kinetic_energy=np.zeros(0),
+            potential_energy=np.zeros(0),
+            impacts=[],
+            status=Status.FAILED,
+            message=message,
+            dt=dt,
+        )
+
     @property
     def energy(self) -> np.ndarray:
         return self.kinetic_energy + self.potential_energy
