@@ -42,7 +42,7 @@ def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray) -> GapJet:
     J = model.jacobian(normal, lever)
     accel = J @ acc6 + model.bias(y, normal, lever)
     vscale = model.velocity_scale(y)
-    return GapJet(gap, vn, accel, noise, 64 * np.finfo(float).eps * vscale + 0.0 * vn)
+    return GapJet(gap, vn, accel, noise, np.full_like(vn, 64 * np.finfo(float).eps * vscale))
 
 
 def first_root_lower_bound(g: float, g1: float, g2: float, K: float, B: float) -> float:
