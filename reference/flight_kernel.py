@@ -94,11 +94,12 @@ def vertex_jet(y, LA, lam, g, px, py):
 def _cubic(c0, c1, c2, c3):
     """First positive root of c0 + c1 d + c2 d² + c3 d³ (c0 > 0, c3 ≤ 0), 1e-3 relative."""
     a, b, c = 3.0 * c3, 2.0 * c2, c1
-    crit = np.empty(2)
+    # critical points of the cubic, sorted (scalars: no allocation in the hot loop)
     m = 0
+    cr0, cr1 = 0.0, 0.0
     if a == 0.0:
         if b != 0.0:
-            crit[0] = -c / b
+            cr0 = -c / b
             m = 1
     else:
         disc = b * b - 4 * a * c
@@ -106,15 +107,14 @@ def _cubic(c0, c1, c2, c3):
             sq = math.sqrt(disc)
             qq = -0.5 * (b + math.copysign(sq, b))
             if qq != 0:
-                crit[0] = qq / a
-                crit[1] = c / qq
+                cr0, cr1 = qq / a, c / qq
                 m = 2
-    if m == 2 and crit[1] < crit[0]:
-        crit[0], crit[1] = crit[1], crit[0]
+    if m == 2 and cr1 < cr0:
+        cr0, cr1 = cr1, cr0
     lo = 0.0
     for i in range(m + 1):
         if i < m:
-            hi = crit[i]
+            hi = cr0 if i == 0 else cr1
             if hi <= lo:
                 continue
         else:
@@ -127,27 +127,37 @@ def _cubic(c0, c1, c2, c3):
             else:
                 return math.inf
         if c0 + hi * (c1 + hi * (c2 + hi * c3)) <= 0.0:
+            # the cubic is monotone on [lo, hi] and changes sign: safeguarded Newton.
+            # Newton approaches a root from one side only, so once its step is below
+            # the tolerance it is pushed a little past the root: the bracket closes.
+            x = 0.5 * (lo + hi)
             for _ in range(200):
-                mid = 0.5 * (lo + hi)
-                d = c1 + mid * (2.0 * c2 + 3.0 * mid * c3)
-                if d != 0.0:
-                    nxt = mid - (c0 + mid * (c1 + mid * (c2 + mid * c3))) / d
-                    if lo < nxt < hi:
-                        mid = nxt
-                if c0 + mid * (c1 + mid * (c2 + mid * c3)) > 0.0:
-                    lo = mid
+                f = c0 + x * (c1 + x * (c2 + x * c3))
+                if f > 0.0:
+                    lo = x
                 else:
-                    hi = mid
-                if hi - lo <= 1e-3 * hi:
+                    hi = x
+                tol = 1e-3 * hi
+                if hi - lo <= tol:
                     break
+                d = c1 + x * (2.0 * c2 + 3.0 * x * c3)
+                nxt = x - f / d if d != 0.0 else 0.5 * (lo + hi)
+                if abs(nxt - x) < 0.25 * tol:
+                    nxt += math.copysign(0.25 * tol, nxt - x)
+                if not lo < nxt < hi:
+                    nxt = 0.5 * (lo + hi)
+                x = nxt
             return lo
         lo = hi
     return math.inf
 
 
 @njit(cache=True)
-def safe_step(g, g1, g2, K, B):
-    """First positive root of max(P2, P3) (reference.events.first_root_lower_bound)."""
+def safe_step(g, g1, g2, K, B, cap=math.inf):
+    """First positive root of max(P2, P3) (reference.events.first_root_lower_bound).
+
+    When P2's root is already ≥ `cap` (the smallest step found so far) the vertex does
+    not bind the step, and P3 is not solved: P2's root is returned."""
     if g <= 0.0:
         return 0.0
     if K > 0.0:
@@ -157,19 +167,24 @@ def safe_step(g, g1, g2, K, B):
         d2 = g / -g1
     else:
         d2 = math.inf
+    if d2 >= cap:
+        return d2
     d3 = _cubic(g, g1, 0.5 * g2, -B / 6.0)
     return max(d2, d3)
 
 
 @njit(cache=True)
-def _window(y, LA, lam, g, radius, n, K, delta, margin, idx):
-    """Indices of the vertices that can reach the ground within `delta` (the others are
-    safe by the quadratic bound P2), centred on the lowest direction; returns count.
+def _window(y, radius, n, K, delta, margin):
+    """The vertices that can reach the ground within `delta` (the others are safe by the
+    quadratic bound P2): an index range k0 − half … k0 + half (mod n) centred on the
+    lowest direction.  O(1): nothing is enumerated.
 
-    gap_k + rate_k δ − Kδ²/2 = Z(δ) + a (cos θ_k, sin θ_k)·u(δ) with
-    Z = z + v_z δ − Kδ²/2 and u = (R20, R21) + δ (A, B), since the vertex height and its
-    rate are linear in the body-frame vertex position; vertex k is safe when
-    a |u| cos(θ_k − ∠u) ≥ −Z."""
+    The P2 bound of vertex k at δ is gap_k + rate_k δ − Kδ²/2 = Z(δ) + a c_k·u(δ), with
+    c_k = (cos θ_k, sin θ_k), Z = z + v_z δ − Kδ²/2 and u = (R20, R21) + δ (A, B), since
+    a vertex's height and rate are linear in its body-frame position.  P2 is concave in
+    δ, so vertex k is safe over [0, δ] when P2 > 0 at 0 and at δ, i.e. when
+    a |u| cos(θ_k − ∠u) > −Z: outside an arc of half-width π − acos(−Z / (a|u|))
+    around ∠u + π.  Returns (k0, half); half = n // 2 means every vertex."""
     w, x, yq, z = y[3], y[4], y[5], y[6]
     R00 = 1 - 2 * (yq * yq + z * z)
     R01 = 2 * (x * yq - w * z)
@@ -192,13 +207,111 @@ def _window(y, LA, lam, g, radius, n, K, delta, margin, idx):
         half = int(math.ceil(W / dth))
     half = min(half + margin, n // 2)
     k0 = int(math.floor(centre / dth + 0.5))
-    m = 0
-    for j in range(-half, half + 1):
-        idx[m] = (k0 + j) % n
-        m += 1
-        if m >= n:
+    return k0, half
+
+
+@njit(cache=True)
+def _circle_step(y, LA, lam, g, radius, B):
+    """A step safe for every vertex at once, from the circle through them (n > SMALL_N).
+
+    A vertex's P3 bound is linear in its body-frame direction c (height, rate and
+    acceleration of a body point are linear in its position):
+    P3_c(δ) = Z3(δ) + c·u3(δ), Z3 = z + v_z δ − g δ²/2 − B δ³/6,
+    u3 = p + δ q + δ² r / 2, with p, q, r the height, rate and acceleration of the body
+    points (a, 0) and (0, a) less those of the centre.  Over all |c| = 1,
+    P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ² |r| / 2, and F is concave on δ ≥ 0 (each
+    term is), so its first root is bracketed from below by chords from δ = 0 and from
+    above by Newton steps.  Returns (root to 1e-3 relative, taken from below; the
+    circle's lowest point F(0) = z − |p|; |p| = a sin α)."""
+    z, vz = y[2], y[9]
+    gx, rx, ax, _ = vertex_jet(y, LA, lam, g, radius, 0.0)
+    gy, ry, ay, _ = vertex_jet(y, LA, lam, g, 0.0, radius)
+    px, py = gx - z, gy - z
+    qx, qy = rx - vz, ry - vz
+    rn = math.sqrt((ax + g) ** 2 + (ay + g) ** 2)
+    pn = math.sqrt(px * px + py * py)
+    f0 = z - pn
+    if f0 <= 0.0:
+        return 0.0, f0, pn
+    lo, flo = 0.0, f0
+    # an upper end: F → −∞ (g > 0); double until F < 0
+    hi = max(f0 / max(abs(vz) + math.sqrt(qx * qx + qy * qy), 1e-300), 1e-300)
+    for _ in range(2000):
+        ux, uy = px + hi * qx, py + hi * qy
+        fhi = z + hi * (vz - hi * (0.5 * g + hi * B / 6.0)) - math.sqrt(ux * ux + uy * uy)
+        fhi -= 0.5 * hi * hi * rn
+        if fhi < 0.0:
             break
-    return m
+        lo, flo = hi, fhi
+        hi *= 2.0
+    for _ in range(100):
+        if hi - lo <= 1e-3 * hi:
+            break
+        # chord from (lo, F(lo)) to (hi, F(hi)): below F on [lo, hi] (concavity)
+        x = lo + (hi - lo) * flo / (flo - fhi)
+        ux, uy = px + x * qx, py + x * qy
+        un = math.sqrt(ux * ux + uy * uy)
+        fx = z + x * (vz - x * (0.5 * g + x * B / 6.0)) - un - 0.5 * x * x * rn
+        if fx >= 0.0:
+            lo, flo = x, fx
+        else:
+            hi, fhi = x, fx
+        # Newton from the upper end: the tangent lies above F, so it stays above the root
+        ux, uy = px + hi * qx, py + hi * qy
+        un = math.sqrt(ux * ux + uy * uy)
+        d = vz - hi * (g + 0.5 * hi * B) - hi * rn
+        if un > 0.0:
+            d -= (ux * qx + uy * qy) / un
+        if d < 0.0:
+            x = hi - fhi / d
+            if lo < x < hi:
+                ux, uy = px + x * qx, py + x * qy
+                un = math.sqrt(ux * ux + uy * uy)
+                fx = z + x * (vz - x * (0.5 * g + x * B / 6.0)) - un - 0.5 * x * x * rn
+                if fx >= 0.0:
+                    lo, flo = x, fx
+                else:
+                    hi, fhi = x, fx
+    return lo, f0, pn
+
+
+# for n > SMALL_N each step examines the vertices near the lowest direction and
+# WINDOW_MAX more on each side, then at most WINDOW_MAX more that could touch within it
+SMALL_N = 32
+WINDOW_MAX = 6
+
+
+@njit(cache=True)
+def _vertex_step(y, g, LA, lam, pts, k, K, B, rate_noise, res):
+    """Examine vertex k: res = (step, hit_ds, hit_k, land_k) updated in place (the
+    smallest safe step, the earliest touching-and-approaching vertex, a touching vertex
+    at rest and pressing in)."""
+    gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
+    if gk <= nk:
+        graze = 4.0 * math.sqrt(2.0 * max(ak, 0.0) * nk)
+        if rk < -max(rate_noise, graze):
+            ds = -gk / rk
+            if ds < res[1]:
+                res[1] = ds
+                res[2] = k
+            return
+        if rk <= rate_noise and ak < 0:
+            res[3] = k
+        gk = max(gk, 0.0) + nk
+    d = safe_step(gk, rk, ak, K, B, res[0])
+    if d < res[0]:
+        res[0] = d
+
+
+@njit(cache=True)
+def _window_step(y, g, LA, lam, pts, n, K, B, k0, half, rate_noise, res):
+    """Examine vertices k0 − half … k0 + half (mod n, each once) with _vertex_step,
+    centre first, then outwards (k0, k0 − 1, k0 + 1, …): the lowest vertices usually
+    bind the step, and a small step found early spares the others' P3."""
+    for j in range(min(2 * half + 1, n)):
+        off = (j + 1) // 2
+        k = (k0 - off if j % 2 else k0 + off) % n
+        _vertex_step(y, g, LA, lam, pts, k, K, B, rate_noise, res)
 
 
 @njit(cache=True)
@@ -207,72 +320,69 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
 
     Returns (s, k, iterations, n_simultaneous, k2, kind) with k = −1 when nothing is
     reached; kind 0 = impact, 1 = activation (touching at rest, pressing in).  `out_y`
-    receives the state at s.  For n > 32 only a window of vertices is examined per step
-    (see _window), so the cost per step does not grow with n."""
+    receives the state at s.  For n > SMALL_N only the window of vertices that can
+    touch within the step is examined (see _window): the step is first bounded from
+    the vertices near the lowest direction (the touching ones and WINDOW_MAX more on each
+    side), then shortened until every vertex that could touch within it by P2 (its
+    window, see _window) has been examined, with at most WINDOW_MAX more examined.
+    The cost per step therefore does not grow with n."""
     n = pts.shape[0]
-    y = np.empty(13)
+    y = out_y
     flight_state(y0, LA, lam, g, 0.0, y)
     s = 0.0
     rate_noise = 64 * EPS * vscale
-    idx = np.empty(n, dtype=np.int64)
-    seen = np.zeros(n, dtype=np.bool_)
-    small_n = n <= 32
+    small_n = n <= SMALL_N
+    res = np.empty(4)  # step, hit_ds, hit_k, land_k
     for it in range(max_iter):
-        step = math.inf
+        res[0], res[1], res[2], res[3] = math.inf, math.inf, -1.0, -1.0
         cap_step = math.inf
-        hit_k = -1
-        hit_s = math.inf
-        land_k = -1
+        d_c = 0.0
         if small_n:
-            m = n
-            for j in range(n):
-                idx[j] = j
+            k0, h0 = _window(y, radius, n, K, 0.0, 0)
+            _window_step(y, g, LA, lam, pts, n, K, B, k0, n // 2, rate_noise, res)
         else:
-            m = _window(y, LA, lam, g, radius, n, K, 0.0, 3, idx)
-        passes = 1 if small_n else 2
-        for p in range(passes):
-            for jj in range(m):
-                k = idx[jj]
-                if seen[k]:
-                    continue
-                seen[k] = True
-                gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
-                if gk <= nk:
-                    graze = 4.0 * math.sqrt(2.0 * max(ak, 0.0) * nk)
-                    if rk < -max(rate_noise, graze):
-                        ds = -gk / rk
-                        if ds < hit_s:
-                            hit_s = ds
-                            hit_k = k
-                        continue
-                    if rk <= rate_noise and ak < 0:
-                        land_k = k
-                    gk = max(gk, 0.0) + nk
-                d = safe_step(gk, rk, ak, K, B)
-                if d < step:
-                    step = d
-            if p == 0 and not small_n:
-                # every vertex that could be unsafe within δ lies in window(δ): shrink δ
-                # until that window is small, and never step beyond δ
-                dlt = min(step, horizon - s)
-                m2 = _window(y, LA, lam, g, radius, n, K, dlt, 3, idx)
-                while m2 > m + 64 and dlt > 0.0:
-                    dlt *= 0.5
-                    m2 = _window(y, LA, lam, g, radius, n, K, dlt, 3, idx)
-                m = m2
+            # far from the ground the circle through the vertices gives the step at
+            # once; within a few sags (a sin α (1 − cos π/n), the most a vertex can sit
+            # above the circle's lowest point) of it, the vertices near the lowest
+            # direction must be examined
+            d_c, f0, pn = _circle_step(y, LA, lam, g, radius, B)
+            if f0 > 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (
+                abs(y[2]) + radius
+            ):
+                step = max(d_c, 1e-15 * max(s, 1e-300))
+                if s + step >= horizon:
+                    flight_state(y0, LA, lam, g, horizon, y)
+                    return horizon, -1, it, 0, -1, 0
+                s += step
+                flight_state(y0, LA, lam, g, s, y)
+                continue
+            # the touching/lowest vertices and WINDOW_MAX more on each side first
+            k0, h0 = _window(y, radius, n, K, 0.0, 3)
+            h = min(h0 + WINDOW_MAX, n // 2)
+            _window_step(y, g, LA, lam, pts, n, K, B, k0, h, rate_noise, res)
+            if res[2] < 0 and res[3] < 0 and 2 * h + 1 < n:
+                # the step they allow, δ, holds for all other vertices if those outside
+                # window(δ) are safe by P2 and those inside have been examined: examine
+                # at most WINDOW_MAX more, shortening δ until that suffices
+                dlt = min(res[0], horizon - s)
+                while True:
+                    k1, h1 = _window(y, radius, n, K, dlt, 3)
+                    d = (k1 - k0) % n
+                    if d > n // 2:
+                        d -= n
+                    lo1, hi1 = d - h1, d + h1  # window(δ) in offsets from k0
+                    extra = max(hi1 - h, 0) + max(-h - lo1, 0)
+                    if 2 * h1 + 1 < n and extra <= WINDOW_MAX:
+                        break
+                    dlt *= 0.25
+                for off in range(h + 1, hi1 + 1):
+                    _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
+                for off in range(lo1, -h):
+                    _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
                 cap_step = dlt
-        # reset the marks (only those set)
-        if small_n:
-            for j in range(n):
-                seen[j] = False
-        else:
-            for jj in range(m):
-                seen[idx[jj]] = False
-            m0 = _window(y, LA, lam, g, radius, n, K, 0.0, 3, idx)
-            for jj in range(m0):
-                seen[idx[jj]] = False
+        hit_k, land_k = int(res[2]), int(res[3])
         if hit_k >= 0:
-            s_hit = s + hit_s
+            s_hit = s + res[1]
             flight_state(y0, LA, lam, g, s_hit, y)
             for _ in range(3):
                 gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[hit_k, 0], pts[hit_k, 1])
@@ -286,15 +396,13 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
             gk0, rk0, ak0, nk0 = vertex_jet(y, LA, lam, g, pts[hit_k, 0], pts[hit_k, 1])
             tres0 = (nk0 + 1e-300) / max(-rk0, 1e-300)
             if small_n:
-                m = n
-                for j in range(n):
-                    idx[j] = j
+                k0, h0 = 0, n // 2
             else:
-                m = _window(y, LA, lam, g, radius, n, K, 0.0, 3, idx)
+                k0, h0 = _window(y, radius, n, K, 0.0, 3)
             n_sim = 1
             k2 = -1
-            for jj in range(m):
-                k = idx[jj]
+            for j in range(min(2 * h0 + 1, n)):
+                k = (k0 - h0 + j) % n
                 if k == hit_k:
                     continue
                 gk, rk, ak, nk = vertex_jet(y, LA, lam, g, pts[k, 0], pts[k, 1])
@@ -303,20 +411,18 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
                 if gk / -rk <= 4.0 * ((nk + 1e-300) / max(-rk, 1e-300) + tres0):
                     n_sim += 1
                     k2 = k
-            out_y[:] = y
             return s_hit, hit_k, it, n_sim, k2, 0
         if land_k >= 0:
-            out_y[:] = y
             return s, land_k, it, 1, -1, 1
-        step = min(step, cap_step)
+        # two certificates, each for every vertex: the examined ones with the window
+        # (min(res[0], cap_step)) and the circle (d_c)
+        step = max(min(res[0], cap_step), d_c)
         step = max(step, 1e-15 * max(s, 1e-300))
         if s + step >= horizon:
             flight_state(y0, LA, lam, g, horizon, y)
-            out_y[:] = y
             return horizon, -1, it, 0, -1, 0
         s += step
         flight_state(y0, LA, lam, g, s, y)
-    out_y[:] = y
     return s, -2, max_iter, 0, -1, 0
 
 

@@ -53,7 +53,7 @@ from .events import gap_jet, next_flight_event
 from .flight import flight_constants, free_flight
 from .impact import apply_normal_impulses, impact_impulse
 from .scene import Scene
-from .trajectory import ImpactEvent, Phase, SampleBuffer, Status, Trajectory
+from .trajectory import ImpactEvent, ImpactLog, Phase, SampleBuffer, Status, Trajectory
 
 
 @dataclass(frozen=True)
@@ -92,14 +92,14 @@ class _Run:
     opts: ReferenceOptions
     clock: _Clock = field(default_factory=_Clock)
     buf: SampleBuffer = field(default_factory=SampleBuffer)
-    impacts: list[ImpactEvent] = field(default_factory=list)
+    impacts: ImpactLog = field(default_factory=ImpactLog)
     phases: list[Phase] = field(default_factory=list)
     stats: dict = field(default_factory=dict)
     max_impacts: int = 100_000
 
     def sample(self, y: np.ndarray, s: float = 0.0) -> None:
         """Record state y at local time s after the clock."""
-        if len(self.buf.t_hi) >= self.opts.max_samples:
+        if len(self.buf) >= self.opts.max_samples:
             return
         c = _Clock()
         c.hi, c.lo = self.clock.hi, self.clock.lo
@@ -319,20 +319,10 @@ def _bounce_compiled(run: _Run, y: np.ndarray) -> tuple[bool, np.ndarray]:
             se,
         )
         run.stats["flight_search_iterations"] += int(iters)
-        for i in range(n_imp):
-            run.impacts.append(
-                ImpactEvent(
-                    t=float(imp[i, 0]),
-                    t_lo=float(imp[i, 1]),
-                    contact=int(imp[i, 2]),
-                    impulse=float(imp[i, 3]),
-                    v_normal_pre=float(imp[i, 4]),
-                    v_normal_post=float(imp[i, 5]),
-                )
-            )
-        room = run.opts.max_samples - len(run.buf.t_hi)
-        for i in range(min(ns, max(room, 0))):
-            run.buf.add(float(st[i, 0]), float(st[i, 1]), sy[i], float(se[i, 0]), float(se[i, 1]))
+        run.impacts.extend_rows(imp[:n_imp])
+        room = max(run.opts.max_samples - len(run.buf), 0)
+        k = min(ns, room)
+        run.buf.extend(st[:k], sy[:k], se[:k])
         run.clock.hi, run.clock.lo = float(hi), float(lo)
         if n_imp:
             run.phases.append(Phase(t0, run.clock.hi, "flight"))

@@ -14,6 +14,7 @@ normal impulse and the pre/post normal velocities of the contact point.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
@@ -71,7 +72,7 @@ class Trajectory:
     angular_velocity: np.ndarray
     kinetic_energy: np.ndarray
     potential_energy: np.ndarray
-    impacts: list[ImpactEvent]
+    impacts: Sequence[ImpactEvent]  # a list or an ImpactLog
     status: Status
     message: str = ""
     t_final: float = 0.0
@@ -115,9 +116,13 @@ class Trajectory:
         return len(self.t)
 
     def impact_times(self) -> np.ndarray:
+        if isinstance(self.impacts, ImpactLog):
+            return self.impacts.column("t")
         return np.array([e.t for e in self.impacts])
 
     def impact_contacts(self) -> np.ndarray:
+        if isinstance(self.impacts, ImpactLog):
+            return self.impacts.column("contact")
         return np.array([e.contact for e in self.impacts], dtype=int)
 
     def final_state(self) -> dict[str, list[float]]:
@@ -167,31 +172,138 @@ def _jsonable(x: Any) -> Any:
 
 
 class SampleBuffer:
-    """Accumulates samples of a run, then freezes them into a Trajectory's arrays."""
+    """Accumulates samples of a run in growing arrays (doubling capacity), one row at a
+    time from Python or a block at a time from the compiled loop, then freezes them into
+    a Trajectory's arrays."""
 
-    def __init__(self) -> None:
-        self.rows: list[np.ndarray] = []
-        self.t_hi: list[float] = []
-        self.t_lo: list[float] = []
-        self.ke: list[float] = []
-        self.pe: list[float] = []
+    def __init__(self, capacity: int = 1024) -> None:
+        self.n = 0
+        self._t = np.empty((capacity, 2))  # t_hi, t_lo
+        self._y = np.empty((capacity, 13))
+        self._e = np.empty((capacity, 2))  # kinetic, potential
+
+    def __len__(self) -> int:
+        return self.n
+
+    def _reserve(self, k: int) -> None:
+        need = self.n + k
+        if need <= len(self._t):
+            return
+        cap = max(need, 2 * len(self._t))
+        for name in ("_t", "_y", "_e"):
+            old = getattr(self, name)
+            new = np.empty((cap, old.shape[1]))
+            new[: self.n] = old[: self.n]
+            setattr(self, name, new)
 
     def add(self, t_hi: float, t_lo: float, y: np.ndarray, ke: float, pe: float) -> None:
-        self.t_hi.append(t_hi)
-        self.t_lo.append(t_lo)
-        self.rows.append(np.array(y, dtype=float))
-        self.ke.append(ke)
-        self.pe.append(pe)
+        self._reserve(1)
+        i = self.n
+        self._t[i] = (t_hi, t_lo)
+        self._y[i] = y
+        self._e[i] = (ke, pe)
+        self.n = i + 1
+
+    def extend(self, t: np.ndarray, y: np.ndarray, e: np.ndarray) -> None:
+        """Append k rows: t (k, 2) = (t_hi, t_lo), y (k, 13) states, e (k, 2) = (KE, PE)."""
+        k = len(t)
+        self._reserve(k)
+        self._t[self.n : self.n + k] = t
+        self._y[self.n : self.n + k] = y
+        self._e[self.n : self.n + k] = e
+        self.n += k
 
     def arrays(self) -> dict[str, np.ndarray]:
-        Y = np.array(self.rows).reshape(-1, 13)
+        n = self.n
+        Y = self._y[:n].copy()
         return {
-            "t": np.array(self.t_hi),
-            "t_lo": np.array(self.t_lo),
+            "t": self._t[:n, 0].copy(),
+            "t_lo": self._t[:n, 1].copy(),
             "position": Y[:, 0:3],
             "quaternion": Y[:, 3:7],
             "velocity": Y[:, 7:10],
             "angular_velocity": Y[:, 10:13],
-            "kinetic_energy": np.array(self.ke),
-            "potential_energy": np.array(self.pe),
+            "kinetic_energy": self._e[:n, 0].copy(),
+            "potential_energy": self._e[:n, 1].copy(),
         }
+
+
+class ImpactLog(Sequence[ImpactEvent]):
+    """The impacts of a run as columns (t, t_lo, contact, impulse, v_normal_pre,
+    v_normal_post) in one growing array: the compiled loop appends thousands of rows at
+    once without creating Python objects.  Reads as a sequence of `ImpactEvent`
+    (built on access), so it stands wherever a list of events does."""
+
+    COLUMNS = ("t", "t_lo", "contact", "impulse", "v_normal_pre", "v_normal_post")
+
+    def __init__(self, events: Iterable[ImpactEvent] = ()) -> None:
+        self._rows = np.empty((256, 6))
+        self._n = 0
+        for e in events:
+            self.append(e)
+
+    def __len__(self) -> int:
+        return self._n
+
+    def _reserve(self, k: int) -> None:
+        need = self._n + k
+        if need > len(self._rows):
+            new = np.empty((max(need, 2 * len(self._rows)), 6))
+            new[: self._n] = self._rows[: self._n]
+            self._rows = new
+
+    def append(self, e: ImpactEvent) -> None:
+        self._reserve(1)
+        self._rows[self._n] = (
+            e.t,
+            e.t_lo,
+            e.contact,
+            e.impulse,
+            e.v_normal_pre,
+            e.v_normal_post,
+        )
+        self._n += 1
+
+    def extend_rows(self, rows: np.ndarray) -> None:
+        """Append rows laid out as COLUMNS."""
+        k = len(rows)
+        self._reserve(k)
+        self._rows[self._n : self._n + k] = rows
+        self._n += k
+
+    def column(self, name: str) -> np.ndarray:
+        """One column as a new array (contact as int)."""
+        col = self._rows[: self._n, self.COLUMNS.index(name)].copy()
+        return col.astype(int) if name == "contact" else col
+
+    @staticmethod
+    def _event(r: np.ndarray) -> ImpactEvent:
+        return ImpactEvent(
+            t=float(r[0]),
+            t_lo=float(r[1]),
+            contact=int(r[2]),
+            impulse=float(r[3]),
+            v_normal_pre=float(r[4]),
+            v_normal_post=float(r[5]),
+        )
+
+    def __getitem__(self, i):  # type: ignore[override]
+        if isinstance(i, slice):
+            return [self._event(r) for r in self._rows[: self._n][i]]
+        if i < 0:
+            i += self._n
+        if not 0 <= i < self._n:
+            raise IndexError("impact index out of range")
+        return self._event(self._rows[i])
+
+    def __iter__(self) -> Iterator[ImpactEvent]:
+        for r in self._rows[: self._n]:
+            yield self._event(r)
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Sequence):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    def __repr__(self) -> str:
+        return f"ImpactLog({self._n} impacts)"
