@@ -173,18 +173,15 @@ def chunk_horizon(model: BodyModel, y: np.ndarray, contacts: list[int], others_j
     """Largest safe chunk: no other contact can reach the ground (quadratic lower bound
     with K = 2 max(|g″|) + g, a factor-2 margin on the current second derivatives), and
     the chunk stays short against the local time scale √(length / acceleration)."""
-    from .flight_kernel import safe_step
+    from .flight_kernel import min_safe_step
 
     g = model.gravity
     acc_scale = float(np.max(np.abs(others_jet.accel))) if len(others_jet.accel) else 0.0
     K = 2.0 * acc_scale + g + 1e-300
-    h = math.inf
-    for k in range(len(others_jet.gap)):
-        if k in contacts:
-            continue
-        gk = max(others_jet.gap[k], others_jet.noise[k])
-        d = safe_step(gk, others_jet.rate[k], others_jet.accel[k], K, 0.0)
-        h = min(h, d)
+    skip = np.zeros(len(others_jet.gap), dtype=bool)
+    skip[list(contacts)] = True
+    j = others_jet
+    h = min_safe_step(j.gap, j.rate, j.accel, j.noise, skip, K, 0.0)
     L = model.length_scale(y)
     T_local = math.sqrt(max(L, 1e-300) / K)
     vs = model.velocity_scale(y)

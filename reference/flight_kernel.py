@@ -153,11 +153,36 @@ def _cubic(c0, c1, c2, c3):
 
 
 @njit(cache=True)
+def _cubic_positive_on(c0, c1, c2, c3, T):
+    """Whether c0 + c1 d + c2 d² + c3 d³ (c0 > 0, c3 ≤ 0) stays positive on [0, T]:
+    positive at T and at its local minimum (the smaller critical point when c3 < 0,
+    where the derivative turns from negative to positive) if that lies inside."""
+    if c0 + T * (c1 + T * (c2 + T * c3)) <= 0.0:
+        return False
+    a, b, c = 3.0 * c3, 2.0 * c2, c1
+    if a == 0.0:
+        if b <= 0.0:
+            return True  # concave or linear: the ends decide
+        dm = -c / b
+    else:
+        disc = b * b - 4.0 * a * c
+        if disc <= 0.0:
+            return True  # derivative never positive: decreasing, the ends decide
+        sq = math.sqrt(disc)
+        r1, r2 = (-b + sq) / (2.0 * a), (-b - sq) / (2.0 * a)  # a < 0: r1 < r2
+        dm = min(r1, r2)
+    if 0.0 < dm < T:
+        return c0 + dm * (c1 + dm * (c2 + dm * c3)) > 0.0
+    return True
+
+
+@njit(cache=True)
 def safe_step(g, g1, g2, K, B, cap=math.inf):
     """First positive root of max(P2, P3) (reference.events.first_root_lower_bound).
 
-    When P2's root is already ≥ `cap` (the smallest step found so far) the vertex does
-    not bind the step, and P3 is not solved: P2's root is returned."""
+    When P2's root is already ≥ `cap` (the smallest step found so far), or P3 stays
+    positive up to `cap`, the vertex does not bind the step and P3 is not solved: a
+    value ≥ cap is returned."""
     if g <= 0.0:
         return 0.0
     if K > 0.0:
@@ -169,8 +194,24 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
         d2 = math.inf
     if d2 >= cap:
         return d2
+    if cap < math.inf and _cubic_positive_on(g, g1, 0.5 * g2, -B / 6.0, cap):
+        return cap  # P3 has no root before cap: this vertex does not bind either
     d3 = _cubic(g, g1, 0.5 * g2, -B / 6.0)
     return max(d2, d3)
+
+
+@njit(cache=True)
+def min_safe_step(gap, rate, accel, noise, skip, K, B):
+    """min over contacts k with not skip[k] of safe_step(max(gap_k, noise_k), rate_k,
+    accel_k, K, B): the step no listed contact can reach the ground within."""
+    h = math.inf
+    for k in range(gap.shape[0]):
+        if skip[k]:
+            continue
+        d = safe_step(max(gap[k], noise[k]), rate[k], accel[k], K, B, h)
+        if d < h:
+            h = d
+    return h
 
 
 @njit(cache=True)
@@ -278,7 +319,7 @@ def _circle_step(y, LA, lam, g, radius, B):
 # for n > SMALL_N each step examines the vertices near the lowest direction and
 # WINDOW_MAX more on each side, then at most WINDOW_MAX more that could touch within it
 SMALL_N = 32
-WINDOW_MAX = 6
+WINDOW_MAX = 3
 
 
 @njit(cache=True)
@@ -333,6 +374,7 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
     rate_noise = 64 * EPS * vscale
     small_n = n <= SMALL_N
     res = np.empty(4)  # step, hit_ds, hit_k, land_k
+    last_dlt = math.inf  # the last window-certified step (a start for the next)
     for it in range(max_iter):
         res[0], res[1], res[2], res[3] = math.inf, math.inf, -1.0, -1.0
         cap_step = math.inf
@@ -346,9 +388,7 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
             # above the circle's lowest point) of it, the vertices near the lowest
             # direction must be examined
             d_c, f0, pn = _circle_step(y, LA, lam, g, radius, B)
-            if f0 > 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (
-                abs(y[2]) + radius
-            ):
+            if f0 > 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (abs(y[2]) + radius):
                 step = max(d_c, 1e-15 * max(s, 1e-300))
                 if s + step >= horizon:
                     flight_state(y0, LA, lam, g, horizon, y)
@@ -357,14 +397,14 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
                 flight_state(y0, LA, lam, g, s, y)
                 continue
             # the touching/lowest vertices and WINDOW_MAX more on each side first
-            k0, h0 = _window(y, radius, n, K, 0.0, 3)
+            k0, h0 = _window(y, radius, n, K, 0.0, 2)
             h = min(h0 + WINDOW_MAX, n // 2)
             _window_step(y, g, LA, lam, pts, n, K, B, k0, h, rate_noise, res)
             if res[2] < 0 and res[3] < 0 and 2 * h + 1 < n:
                 # the step they allow, δ, holds for all other vertices if those outside
                 # window(δ) are safe by P2 and those inside have been examined: examine
                 # at most WINDOW_MAX more, shortening δ until that suffices
-                dlt = min(res[0], horizon - s)
+                dlt = min(res[0], horizon - s, 4.0 * last_dlt)  # start near the last
                 while True:
                     k1, h1 = _window(y, radius, n, K, dlt, 3)
                     d = (k1 - k0) % n
@@ -380,6 +420,7 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
                 for off in range(lo1, -h):
                     _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
                 cap_step = dlt
+                last_dlt = dlt
         hit_k, land_k = int(res[2]), int(res[3])
         if hit_k >= 0:
             s_hit = s + res[1]

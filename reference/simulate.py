@@ -361,17 +361,14 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
         acc = constrained_acceleration(model, y, active)
         jet = gap_jet(model, y, acc)
         vnoise = _rate_noise(model, y)
-        others = [k for k in range(model.n_contacts) if k not in active]
-        noise = np.maximum(jet.noise, gap_res)
-        hitting = [k for k in others if jet.gap[k] <= noise[k] and jet.rate[k] < -vnoise]
+        other = np.ones(model.n_contacts, dtype=bool)
+        other[active] = False
+        touching = other & (jet.gap <= np.maximum(jet.noise, gap_res))
+        hitting = np.flatnonzero(touching & (jet.rate < -vnoise)).tolist()
         if hitting:
             _close_contact_phase(run, t0, active, E_start, y)
             return _resolve(run, y, hitting, list(active))
-        landing = [
-            k
-            for k in others
-            if jet.gap[k] <= noise[k] and jet.rate[k] <= vnoise and jet.accel[k] < 0
-        ]
+        landing = np.flatnonzero(touching & (jet.rate <= vnoise) & (jet.accel < 0)).tolist()
         if landing:
             _close_contact_phase(run, t0, active, E_start, y)
             return _activate(run, y, landing, list(active))
@@ -393,7 +390,7 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
         lam_new = contact_forces(model, y_new, active)
         # penetration guard for the other contacts (must not happen: conservative horizon)
         gap_new, _, _, _, noise_new = model.contacts(y_new)
-        crossed = [k for k in others if gap_new[k] < -np.maximum(noise_new[k], gap_res)]
+        crossed = np.flatnonzero(other & (gap_new < -np.maximum(noise_new, gap_res))).tolist()
         if crossed:
             # the horizon bound was not enough: find the first crossing on the dense
             # output and stop there (counted: the bound should make this rare)

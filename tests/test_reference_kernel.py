@@ -107,3 +107,30 @@ def test_large_n_search_finds_the_event_of_the_all_vertex_search(n, count):
         assert abs(nb.s - py.s) <= 1e-12 * max(1.0, py.s)
         compared += 1
     assert compared >= count // 2
+
+
+@pytest.mark.parametrize("n,n_compare", [(100, 20), (1000, 12), (10_000, 4)])
+def test_large_n_runs_agree_with_the_python_specification(n, n_compare, monkeypatch):
+    """Whole runs of a bouncing n-gon (searches starting right after an impact, with the
+    impacting vertex and its neighbours within roundoff of the ground): the compiled
+    loop with its vertex window and circle bound gives the impacts of the Python path,
+    which examines every vertex at every step."""
+    from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear
+
+    scene = Scene(
+        name=f"n{n}-elastic",
+        body=Body(n=n, gyration=0.5),
+        ground=Ground(),
+        initial=initial_from_linear((0.01, -0.004, 0.03), (0.03, 0.05, -0.2)),
+        restitution=1.0,
+        gravity=1.0,
+        run=RunSettings(t_end=100.0, max_impacts=n_compare),
+    )
+    monkeypatch.setattr(events, "USE_KERNEL", False)
+    py = simulate(scene)
+    monkeypatch.setattr(events, "USE_KERNEL", True)
+    nb = simulate(scene)
+    assert len(py.impacts) == len(nb.impacts) == n_compare
+    for a, b in zip(py.impacts, nb.impacts, strict=True):
+        assert a.contact == b.contact
+        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-12
