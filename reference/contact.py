@@ -169,19 +169,18 @@ def integrate_chunk(
     return out, (sol.sol if dense else None), int(sol.nfev)
 
 
-def chunk_horizon(model: BodyModel, y: np.ndarray, contacts: list[int], others_jet) -> float:
-    """Largest safe chunk: no other contact can reach the ground (quadratic lower bound
-    with K = 2 max(|g″|) + g, a factor-2 margin on the current second derivatives), and
-    the chunk stays short against the local time scale √(length / acceleration)."""
+def chunk_horizon(model: BodyModel, y: np.ndarray, jet, held: np.ndarray) -> float:
+    """Largest safe chunk: no contact other than the `held` ones (a mask) can reach the
+    ground (quadratic lower bound with K = 2 max(|g″|) + g over them, a factor-2 margin
+    on the current second derivatives), and the chunk stays short against the local
+    time scale √(length / acceleration)."""
     from .flight_kernel import min_safe_step
 
     g = model.gravity
-    acc_scale = float(np.max(np.abs(others_jet.accel))) if len(others_jet.accel) else 0.0
+    free = ~held
+    acc_scale = float(np.max(np.abs(jet.accel[free]))) if free.any() else 0.0
     K = 2.0 * acc_scale + g + 1e-300
-    skip = np.zeros(len(others_jet.gap), dtype=bool)
-    skip[list(contacts)] = True
-    j = others_jet
-    h = min_safe_step(j.gap, j.rate, j.accel, j.noise, skip, K, 0.0)
+    h = min_safe_step(jet.gap, jet.rate, jet.accel, jet.noise, held, K, 0.0)
     L = model.length_scale(y)
     T_local = math.sqrt(max(L, 1e-300) / K)
     vs = model.velocity_scale(y)

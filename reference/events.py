@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .body import BodyModel, V, X
+from .body import NEAR_GROUND_ALL, BodyModel, V, X
 from .flight import FlightConstants, flight_acceleration, free_flight
 
 
@@ -36,11 +36,21 @@ class GapJet:
     rate_noise: np.ndarray
 
 
-def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray) -> GapJet:
-    """g, g′ = J u, g″ = J [v̇; ω̇] + bias for every contact, at state y with accelerations."""
-    gap, normal, lever, vn, noise = model.contacts(y)
+def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray, idx=None) -> GapJet:
+    """g, g′ = J u, g″ = J [v̇; ω̇] + bias for the contacts `idx` (every contact by
+    default), at state y with accelerations acc6.  Large polygons over flat ground
+    use the compiled loop (reference.flight_kernel.gap_jet_flat)."""
+    n = model.n_contacts
+    if idx is None and model.flat and n > NEAR_GROUND_ALL:
+        from .flight_kernel import gap_jet_flat
+
+        gap, vn, accel, noise = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+        gap_jet_flat(y, model.points, np.asarray(acc6, dtype=float), gap, vn, accel, noise)
+        rn = np.full_like(vn, 64 * np.finfo(float).eps * model.velocity_scale(y))
+        return GapJet(gap, vn, accel, noise, rn)
+    gap, normal, lever, vn, noise = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
-    accel = J @ acc6 + model.bias(y, normal, lever)
+    accel = J @ acc6 + model.bias(y, normal, lever, idx)
     vscale = model.velocity_scale(y)
     return GapJet(gap, vn, accel, noise, np.full_like(vn, 64 * np.finfo(float).eps * vscale))
 

@@ -201,6 +201,33 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
 
 
 @njit(cache=True)
+def gap_jet_flat(y, pts, acc6, gap, rate, accel, noise):
+    """Gap, rate, normal acceleration and gap roundoff of every vertex over flat ground
+    (reference.events.gap_jet for n = e_z) into the given arrays: with r = R p,
+    g = z + r_z, g′ = v_z + (ω × r)_z, g″ = a_z + (ω̇ × r)_z + (ω·r) ω_z − |ω|² r_z."""
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    R00 = 1 - 2 * (yq * yq + z * z)
+    R01 = 2 * (x * yq - w * z)
+    R10 = 2 * (x * yq + w * z)
+    R11 = 1 - 2 * (x * x + z * z)
+    R20 = 2 * (x * z - w * yq)
+    R21 = 2 * (yq * z + w * x)
+    wx, wy, wz = y[10], y[11], y[12]
+    ww = wx * wx + wy * wy + wz * wz
+    for k in range(pts.shape[0]):
+        px, py = pts[k, 0], pts[k, 1]
+        rx = R00 * px + R01 * py
+        ry = R10 * px + R11 * py
+        rz = R20 * px + R21 * py
+        gap[k] = y[2] + rz
+        rate[k] = y[9] + (wx * ry - wy * rx)
+        accel[k] = (
+            acc6[2] + (acc6[3] * ry - acc6[4] * rx) + (wx * rx + wy * ry + wz * rz) * wz - ww * rz
+        )
+        noise[k] = 8 * EPS * (abs(y[2]) + abs(rz))
+
+
+@njit(cache=True)
 def min_safe_step(gap, rate, accel, noise, skip, K, B):
     """min over contacts k with not skip[k] of safe_step(max(gap_k, noise_k), rate_k,
     accel_k, K, B): the step no listed contact can reach the ground within."""

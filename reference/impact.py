@@ -28,21 +28,32 @@ class ImpactResult:
     others_post: np.ndarray  # normal velocities of all contacts after the impact
 
 
-def impact_impulse(model: BodyModel, y: np.ndarray, k: int, gamma: float) -> ImpactResult:
-    """Apply the Newtonian impact at contact k to state y (positions unchanged)."""
-    gap, normal, lever, vn, _ = model.contacts(y)
+def impact_impulse(
+    model: BodyModel, y: np.ndarray, k: int, gamma: float, watch: list[int] | None = None
+) -> ImpactResult:
+    """Apply the Newtonian impact at contact k to state y (positions unchanged):
+    impulse ζ = −(1 + γ) u⁻ / (J_k M⁻¹ J_kᵀ) along J_k, so that u⁺ = −γ u⁻.
+
+    `others_post` holds the post-impact normal velocities of the contacts in `watch`
+    (all contacts when None; NaN for the unwatched), so a caller that needs only the
+    resting ones does not pay for every vertex of a large polygon."""
+    idx = np.arange(model.n_contacts) if watch is None else np.array([k, *watch], dtype=int)
+    gap, normal, lever, vn, _ = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])
-    jk = J[k]
+    row = k if watch is None else 0
+    jk = J[row]
     w = float(jk @ Minv @ jk)
-    u_pre = float(vn[k])
+    u_pre = float(vn[row])
     zeta = -(1.0 + gamma) * u_pre / w
     dq = Minv @ jk * zeta
     y_post = np.array(y, dtype=float)
     y_post[V] += dq[:3]
     y_post[W] += dq[3:]
-    vn_post = J @ np.concatenate([y_post[V], y_post[W]])
-    return ImpactResult(y_post, zeta, u_pre, float(vn_post[k]), vn_post)
+    vn_idx = J @ np.concatenate([y_post[V], y_post[W]])
+    vn_post = np.full(model.n_contacts, np.nan)
+    vn_post[idx] = vn_idx
+    return ImpactResult(y_post, zeta, u_pre, float(vn_idx[row]), vn_post)
 
 
 def apply_normal_impulses(
@@ -54,11 +65,11 @@ def apply_normal_impulses(
     momentum and vertical angular momentum are untouched on flat ground."""
     if not contacts:
         return y
-    gap, normal, lever, vn, _ = model.contacts(y)
-    J = model.jacobian(normal, lever)[contacts]
+    gap, normal, lever, vn, _ = model.contacts(y, np.asarray(contacts, dtype=int))
+    J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])
     A = J @ Minv @ J.T
-    mu = np.linalg.solve(A, np.asarray(target_vn) - vn[contacts])
+    mu = np.linalg.solve(A, np.asarray(target_vn) - vn)
     dq = Minv @ J.T @ mu
     out = np.array(y, dtype=float)
     out[V] += dq[:3]

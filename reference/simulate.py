@@ -361,9 +361,9 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
         acc = constrained_acceleration(model, y, active)
         jet = gap_jet(model, y, acc)
         vnoise = _rate_noise(model, y)
-        other = np.ones(model.n_contacts, dtype=bool)
-        other[active] = False
-        touching = other & (jet.gap <= np.maximum(jet.noise, gap_res))
+        held = np.zeros(model.n_contacts, dtype=bool)
+        held[active] = True
+        touching = ~held & (jet.gap <= np.maximum(jet.noise, gap_res))
         hitting = np.flatnonzero(touching & (jet.rate < -vnoise)).tolist()
         if hitting:
             _close_contact_phase(run, t0, active, E_start, y)
@@ -373,7 +373,7 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
             _close_contact_phase(run, t0, active, E_start, y)
             return _activate(run, y, landing, list(active))
         lam = contact_forces(model, y, active)
-        h = chunk_horizon(model, y, active, jet)
+        h = chunk_horizon(model, y, jet, held)
         if lam_prev is not None and h_prev:
             rate = (lam - lam_prev) / h_prev
             for i in range(len(lam)):
@@ -389,15 +389,18 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
         run.stats["contact_rhs_evals"] += nfev
         lam_new = contact_forces(model, y_new, active)
         # penetration guard for the other contacts (must not happen: conservative horizon)
-        gap_new, _, _, _, noise_new = model.contacts(y_new)
-        crossed = np.flatnonzero(other & (gap_new < -np.maximum(noise_new, gap_res))).tolist()
+        # (every vertex below the ground at the chunk's end lies in near_ground(0))
+        below = model.near_ground(y_new, 0.0)
+        below = below[~held[below]]
+        gap_new, _, _, _, noise_new = model.contacts(y_new, below)
+        crossed = below[gap_new < -np.maximum(noise_new, gap_res)].tolist()
         if crossed:
             # the horizon bound was not enough: find the first crossing on the dense
             # output and stop there (counted: the bound should make this rare)
             run.stats["horizon_backstops"] = run.stats.get("horizon_backstops", 0) + 1
 
             def min_gap(s, sol=sol, crossed=crossed):
-                return min(model.contacts(sol(s))[0][k] for k in crossed)
+                return float(np.min(model.contacts(sol(s), crossed)[0]))
 
             s_star = _first_zero(min_gap, h)
             y, _, nfev = integrate_chunk(model, y, active, s_star, run.opts.contact_rtol)
@@ -486,9 +489,9 @@ def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
             None,
         )
     k = hitting[0]
-    gap = model.contacts(y)[0]
-    run.stats["max_penetration"] = max(run.stats["max_penetration"], float(-gap[k]))
-    res = impact_impulse(model, y, k, run.gamma)
+    gap_k = float(model.contacts(y, [k])[0][0])
+    run.stats["max_penetration"] = max(run.stats["max_penetration"], -gap_k)
+    res = impact_impulse(model, y, k, run.gamma, watch=list(resting))
     vnoise = _rate_noise(model, y)
     pushed = [j for j in resting if res.others_post[j] < -vnoise]
     if pushed:
@@ -516,7 +519,7 @@ def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
     # times good to 1e-4 of a bounce) completion takes over.
     small = run.opts.chatter_tol * model.velocity_scale(y) if run.gamma < 1.0 else vnoise
     if run.gamma < 1.0:
-        noise_k = model.contacts(y)[4][k]
+        noise_k = float(model.contacts(y, [k])[4][0])
         a_scale = model.gravity + model.radius * float(y[W] @ y[W])
         small = max(small, 100.0 * math.sqrt(2.0 * a_scale * noise_k))
     small = max(small, vnoise)
@@ -529,7 +532,7 @@ def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
     elif u <= small:
         # would k fall back?  normal acceleration with the other candidates held
         acc = constrained_acceleration(model, y, candidates)
-        a_n = gap_jet(model, y, acc).accel[k]
+        a_n = float(gap_jet(model, y, acc, [k]).accel[0])
         if a_n < 0 or u <= vnoise:
             run.stats["chatter_completions"] += 1
             rel = u / model.velocity_scale(y)
