@@ -55,6 +55,10 @@ from .impact import apply_normal_impulses, impact_impulse
 from .scene import Scene
 from .trajectory import ImpactEvent, ImpactLog, Phase, SampleBuffer, Status, Trajectory
 
+# compiled contact phases over flat ground (reference.contact_kernel); the Python loop
+# below stays the specification and handles every event
+USE_CONTACT_KERNEL = True
+
 
 @dataclass(frozen=True)
 class ReferenceOptions:
@@ -357,7 +361,21 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
     # Gap resolution in a contact phase: roundoff, or the integrator's tolerance on the
     # positions (it resolves gaps only to ~rtol of the phase's length scale).
     gap_res = 16 * run.opts.contact_rtol * model.length_scale(y)
+    compiled = model.flat and USE_CONTACT_KERNEL and 1 <= len(active) <= 2
     while True:
+        if compiled:
+            # the compiled loop runs the plain chunks; it stops at anything that is an
+            # event, and a chunk it hands back (lift-off or crossing inside) is redone
+            # below once, with dense output and root finding, before it runs again
+            y, ds, lam_prev, h_prev, code = _contact_compiled(
+                run, y, active, remaining - s_done, gap_res, lam_prev, h_prev
+            )
+            s_done += ds
+            if code == "t_end":
+                run.sample(y)
+                _close_contact_phase(run, t0, active, E_start, y)
+                return None
+        compiled = model.flat and USE_CONTACT_KERNEL and 1 <= len(active) <= 2
         acc = constrained_acceleration(model, y, active)
         jet = gap_jet(model, y, acc)
         vnoise = _rate_noise(model, y)
@@ -439,6 +457,59 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
             run.sample(y)
             _close_contact_phase(run, t0, active, E_start, y)
             return None
+
+
+def _contact_compiled(run: _Run, y, active, left, gap_res, lam_prev, h_prev):
+    """Run reference.contact_kernel.contact_loop from y with `active` held; returns
+    (y, time advanced, lam_prev, h_prev, "t_end" | "python"): "python" leaves the next
+    step (an event at y, or a chunk to redo from y) to the Python loop."""
+    from . import contact_kernel as ck
+
+    m = run.model
+    sample_dt = run.opts.sample_dt or run.t_end / 2000.0
+    cap = 4096
+    st, sy, se = np.empty((cap, 2)), np.empty((cap, 13)), np.empty((cap, 2))
+    lp = np.zeros(2)
+    if lam_prev is not None:
+        lp[: len(lam_prev)] = lam_prev
+    hp = h_prev or 0.0
+    s_total = 0.0
+    while True:
+        code, y, hi, lo, ds, chunks, nfev, ns, hp = ck.contact_loop(
+            y,
+            np.asarray(active, dtype=np.int64),
+            m.points,
+            m.mass,
+            m.i1,
+            m.i3,
+            m.gravity,
+            m.radius,
+            run.opts.contact_rtol,
+            gap_res,
+            run.clock.hi,
+            run.clock.lo,
+            left - s_total,
+            sample_dt,
+            lp,
+            hp,
+            st,
+            sy,
+            se,
+        )
+        run.stats["contact_chunks"] += int(chunks)
+        run.stats["contact_rhs_evals"] += int(nfev)
+        run.stats["compiled_contact_chunks"] = run.stats.get("compiled_contact_chunks", 0) + int(
+            chunks
+        )
+        k = min(ns, max(run.opts.max_samples - len(run.buf), 0))
+        run.buf.extend(st[:k], sy[:k], se[:k])
+        run.clock.hi, run.clock.lo = float(hi), float(lo)
+        s_total += ds
+        if code != ck.EXIT_FULL:
+            break
+    lam_out = lp[: len(active)].copy() if hp > 0 else None
+    kind = "t_end" if code == ck.EXIT_T_END else "python"
+    return y, s_total, lam_out, (hp if hp > 0 else None), kind
 
 
 def _first_zero(f, h: float) -> float:
