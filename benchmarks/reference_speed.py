@@ -14,8 +14,12 @@ family of flat n-gons started from elastic-hexagon's linear state (q = (0.01, �
 0.03), p = (0.03, 0.05, −0.2), ρ = 0.5) with γ = 1 (elastic: the motion goes on, so the
 cost per impact is a steady rate) and γ = 0.8 (impacts dissipate: chatter, sustained
 contact phases), each to a fixed number of impacts (t_end = 1e6, so the grid sampling
-costs nothing).  `--profile` prints cProfile's top entries (cumulative and own time)
-for n = 3 and n = 10,000, elastic and γ = 0.8.
+costs nothing); and the triangle at γ = 0.5, 0.9, 0.99 run to its end (`…-to-end`).
+The per-impact costs of the γ = 0.8 family depend on how often each polygon chatters
+(every chatter is a completion and a contact phase, ~1 ms in Python whatever n): the
+printed counts of completions and contact chunks say how the mixes differ.
+`--profile` prints cProfile's top entries (cumulative and own time) for n = 3 and
+n = 10,000, elastic and γ = 0.8.
 
 This is a benchmark, not a test: nothing here asserts a speed.
 """
@@ -66,6 +70,10 @@ def cases() -> dict[str, Scene]:
         out[f"n{n}-elastic"] = polygon(n, 1.0, 20_000)
     for n in (3, 10, 100, 1000, 10_000):
         out[f"n{n}-gamma0.8"] = polygon(n, 0.8, 2000)
+    # the triangle with 0 < γ < 1 run to its end (a γ < 1 run is finite: chatter, then a
+    # simultaneous impact or the singularity), so the rate includes every phase
+    for gamma in (0.5, 0.9, 0.99):
+        out[f"n3-gamma{gamma:g}-to-end"] = polygon(3, gamma, 1_000_000)
     return out
 
 
@@ -91,6 +99,14 @@ def measure(scene: Scene, repeats: int) -> dict:
         "impacts_per_s": n / med if n else None,
         "us_per_impact": 1e6 * med / n if n else None,
         "contact_chunks": traj.stats.get("contact_chunks"),
+        "contact_phases": sum(1 for ph in traj.phases if ph.kind == "contact"),
+        # wall time of the last timed run outside the compiled flight/impact loop
+        "outside_bounce_loop_s": traj.stats["wall_time_s"] - traj.stats.get("bounce_loop_s", 0.0),
+        "bounce_loop_us_per_impact": (
+            1e6 * traj.stats["bounce_loop_s"] / traj.stats["bounce_loop_impacts"]
+            if traj.stats.get("bounce_loop_impacts")
+            else None
+        ),
         "chatter_completions": traj.stats.get("chatter_completions"),
         "load_1min": load,
     }
@@ -126,17 +142,18 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"unknown case(s) {unknown}; choose from {list(all_cases)}")
     load0 = os.getloadavg()
     rows = []
-    header = f"{'case':18s} {'status':20s} {'impacts':>8s} {'median[s]':>10s} {'min[s]':>9s}"
-    header += f" {'impacts/s':>10s} {'us/impact':>10s} {'load':>5s}"
+    header = f"{'case':22s} {'status':20s} {'impacts':>8s} {'median[s]':>10s} {'min[s]':>9s}"
+    header += f" {'impacts/s':>10s} {'us/impact':>10s} {'chatter':>7s} {'chunks':>6s} {'load':>5s}"
     print(header)
     for name in names:
         r = measure(all_cases[name], args.repeats)
         r["case"] = name
         rows.append(r)
         print(
-            f"{name:18s} {r['status']:20s} {r['impacts']:8d} {r['wall_median_s']:10.4f} "
+            f"{name:22s} {r['status']:20s} {r['impacts']:8d} {r['wall_median_s']:10.4f} "
             f"{r['wall_min_s']:9.4f} {r['impacts_per_s'] or 0:10.0f} "
-            f"{r['us_per_impact'] or 0:10.1f} {r['load_1min']:5.2f}",
+            f"{r['us_per_impact'] or 0:10.1f} {r['chatter_completions']:7d} "
+            f"{r['contact_chunks']:6d} {r['load_1min']:5.2f}",
             flush=True,
         )
     by = {r["case"]: r for r in rows}
@@ -146,7 +163,20 @@ def main(argv: list[str] | None = None) -> int:
         if a and b and a["us_per_impact"] and b["us_per_impact"]:
             ratios[fam] = b["us_per_impact"] / a["us_per_impact"]
             print(f"per-impact cost n=10,000 / n=10 ({fam}): {ratios[fam]:.2f}x (target <= 2)")
-    for name in ("n3-elastic", "n3-gamma0.8", "triangle-chatter"):
+            if fam != "elastic":
+                # split: the compiled flight/impact loop per impact, everything else
+                # (chatter completions, contact phases, events in Python) per contact phase
+                for r in (a, b):
+                    per_phase = r["outside_bounce_loop_s"] / max(r["contact_phases"], 1)
+                    print(
+                        f"  n={r['n']}: compiled loop {r['bounce_loop_us_per_impact'] or 0:.1f} "
+                        f"us/impact; the rest {1e3 * per_phase:.2f} ms per contact phase "
+                        f"({r['contact_phases']} phases, {r['chatter_completions']} chatter "
+                        f"completions in {r['impacts']} impacts)"
+                    )
+    triangles = ["n3-elastic", "n3-gamma0.8", "triangle-chatter"]
+    triangles += [k for k in by if k.startswith("n3-gamma") and k.endswith("-to-end")]
+    for name in triangles:
         if name in by and by[name]["impacts_per_s"]:
             ips = by[name]["impacts_per_s"]
             print(f"{name}: {ips:,.0f} impacts/s = {ips / 1e5:.3g} of the 100,000/s target")

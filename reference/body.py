@@ -30,6 +30,9 @@ X, Q, V, W = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
 
 # near_ground lists every vertex of polygons up to this size (the arc is not worth it)
 NEAR_GROUND_ALL = 64
+# flat-ground contact kinematics from the compiled loops of reference.body_kernel (the
+# array expressions below stay as their specification)
+COMPILED_KINEMATICS = True
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -94,6 +97,15 @@ class BodyModel:
         is the roundoff level of the gap (a few ulps of the terms that form it)."""
         x, q, v, w = y[X], y[Q], y[V], y[W]
         pts = self.points if idx is None else self.points[idx]
+        if self.flat and COMPILED_KINEMATICS:
+            from .body_kernel import contacts_flat
+
+            k = len(pts)
+            gap, lever, vn, noise = np.empty(k), np.empty((k, 3)), np.empty(k), np.empty(k)
+            contacts_flat(np.asarray(y, dtype=float), pts, gap, lever, vn, noise)
+            normal = np.zeros((k, 3))
+            normal[:, 2] = 1.0
+            return gap, normal, lever, vn, noise
         if self.flat:
             R = qt.to_matrix(q)
             # z-row computed from the small quaternion terms directly
@@ -143,7 +155,14 @@ class BodyModel:
         return (k0 + np.arange(-half, half + 1)) % n
 
     def jacobian(self, normal: np.ndarray, lever: np.ndarray) -> np.ndarray:
-        """Rows J_k = [n_kᵀ, (r_k × n_k)ᵀ] mapping (v, ω) to normal velocities."""
+        """Rows J_k = [n_kᵀ, (r_k × n_k)ᵀ] mapping (v, ω) to normal velocities
+        (flat ground: n = e_z, r × e_z = (r_y, −r_x, 0))."""
+        if self.flat:
+            J = np.zeros((len(lever), 6))
+            J[:, 2] = 1.0
+            J[:, 3] = lever[:, 1]
+            J[:, 4] = -lever[:, 0]
+            return J
         return np.concatenate([normal, cross(lever, normal)], axis=1)
 
     def bias(self, y: np.ndarray, normal: np.ndarray, lever: np.ndarray, idx=None) -> np.ndarray:

@@ -18,6 +18,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from . import body as body_mod
 from . import quaternion as qt
 from .body import BodyModel, Q, V, W, X
 
@@ -25,6 +26,17 @@ from .body import BodyModel, Q, V, W, X
 def contact_system(model: BodyModel, y: np.ndarray, contacts: list[int]):
     """(A, b, J, Minv, acc_free) for the contacts held, at state y."""
     idx = np.asarray(contacts, dtype=int)
+    if model.flat and body_mod.COMPILED_KINEMATICS:
+        from .body_kernel import contact_system_flat
+
+        m = len(idx)
+        A, b, J = np.empty((m, m)), np.empty(m), np.empty((m, 6))
+        Minv, acc_free = np.empty((6, 6)), np.empty(6)
+        contact_system_flat(
+            np.asarray(y, dtype=float), model.points[idx], model.mass, model.i1, model.i3,
+            model.gravity, A, b, J, Minv, acc_free,
+        )  # fmt: skip
+        return A, b, J, Minv, acc_free
     gap, normal, lever, vn, _ = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])

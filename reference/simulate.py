@@ -301,6 +301,7 @@ def _bounce_compiled(run: _Run, y: np.ndarray) -> tuple[bool, np.ndarray]:
     while True:
         left = run.max_impacts - len(run.impacts)
         t0 = run.clock.hi
+        wall0 = time.perf_counter()
         code, y, hi, lo, n_imp, ns, iters, _k = fk.bounce_loop(
             y,
             m.mass,
@@ -323,6 +324,10 @@ def _bounce_compiled(run: _Run, y: np.ndarray) -> tuple[bool, np.ndarray]:
             se,
         )
         run.stats["flight_search_iterations"] += int(iters)
+        run.stats["bounce_loop_s"] = run.stats.get("bounce_loop_s", 0.0) + (
+            time.perf_counter() - wall0
+        )
+        run.stats["bounce_loop_impacts"] = run.stats.get("bounce_loop_impacts", 0) + int(n_imp)
         run.impacts.extend_rows(imp[:n_imp])
         room = max(run.opts.max_samples - len(run.buf), 0)
         k = min(ns, room)
