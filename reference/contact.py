@@ -88,16 +88,17 @@ def solve_contact_lcp(
 def constrained_rhs(model: BodyModel, contacts: list[int], compiled: bool = True):
     """dy/dt with the contacts held as bilateral constraints (forces may go negative:
     that is the lift-off signal).  Flat ground with one or two contacts uses the
-    compiled closed form (reference.flight_kernel.constrained_rhs_flat)."""
+    compiled closed form (reference.contact_kernel.held_rhs)."""
     if compiled and model.flat and 1 <= len(contacts) <= 2:
-        from .flight_kernel import constrained_rhs_flat
+        from .contact_kernel import held_rhs
 
         held = np.ascontiguousarray(model.points[list(contacts)])
         m, i1, i3, g = model.mass, model.i1, model.i3, model.gravity
+        lam = np.empty(2)
 
         def rhs_fast(_t: float, y: np.ndarray) -> np.ndarray:
             dy = np.empty(13)
-            constrained_rhs_flat(y, held, m, i1, i3, g, dy)
+            held_rhs(y, held, m, i1, i3, g, dy, lam)
             return dy
 
         return rhs_fast

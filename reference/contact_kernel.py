@@ -25,7 +25,15 @@ import numpy as np
 from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
-from .flight_kernel import EPS, _record_sample, _two_sum_add, gap_jet_flat, min_safe_step
+from .flight_kernel import (
+    EPS,
+    _record_sample,
+    _two_sum_add,
+    free_angular_acceleration,
+    gap_jet_flat,
+    min_safe_step,
+    rotation_xy,
+)
 
 # DOP853 (Hairer's 8(5,3)), the tableau scipy uses: 12 stages + the final derivative
 N_STAGES = _dop.N_STAGES
@@ -49,23 +57,10 @@ def held_rhs(y, held, mass, i1, i3, g, dy, lam):
     """dy/dt with the body-frame vertices `held` (1 or 2 rows) kept on flat ground, and
     their normal forces λ (reference.contact.constrained_rhs): a_n = A λ + b = 0 in
     closed form, A = J M⁻¹ Jᵀ with J_k = [e_z, r_k × e_z]."""
-    w, x, yq, z = y[3], y[4], y[5], y[6]
-    e3x = 2 * (x * z + w * yq)
-    e3y = 2 * (yq * z - w * x)
-    e3z = 1 - 2 * (x * x + yq * yq)
+    ax0, ay0, az0, e3x, e3y, e3z = free_angular_acceleration(y, i1, i3)
+    R00, R01, R10, R11, R20, R21 = rotation_xy(y)
     wx, wy, wz = y[10], y[11], y[12]
-    w3 = wx * e3x + wy * e3y + wz * e3z
-    Lx = i1 * wx + (i3 - i1) * w3 * e3x
-    Ly = i1 * wy + (i3 - i1) * w3 * e3y
-    Lz = i1 * wz + (i3 - i1) * w3 * e3z
-    gx = wy * Lz - wz * Ly
-    gy = wz * Lx - wx * Lz
-    gz = wx * Ly - wy * Lx
     f = 1.0 / i3 - 1.0 / i1
-    eg = e3x * gx + e3y * gy + e3z * gz
-    ax0 = -(gx / i1 + f * eg * e3x)
-    ay0 = -(gy / i1 + f * eg * e3y)
-    az0 = -(gz / i1 + f * eg * e3z)
     m = held.shape[0]
     c0x = c0y = c1x = c1y = 0.0
     i0x = i0y = i0z = i1x = i1y = i1z = 0.0
@@ -73,9 +68,9 @@ def held_rhs(y, held, mass, i1, i3, g, dy, lam):
     ww = wx * wx + wy * wy + wz * wz
     for i in range(m):
         px, py = held[i, 0], held[i, 1]
-        rx = (1 - 2 * (yq * yq + z * z)) * px + 2 * (x * yq - w * z) * py
-        ry = 2 * (x * yq + w * z) * px + (1 - 2 * (x * x + z * z)) * py
-        rz = 2 * (x * z - w * yq) * px + 2 * (yq * z + w * x) * py
+        rx = R00 * px + R01 * py
+        ry = R10 * px + R11 * py
+        rz = R20 * px + R21 * py
         cx, cy = ry, -rx  # r × e_z
         ec = e3x * cx + e3y * cy
         bi = -g + cx * ax0 + cy * ay0 + (wx * rx + wy * ry + wz * rz) * wz - ww * rz
@@ -95,6 +90,7 @@ def held_rhs(y, held, mass, i1, i3, g, dy, lam):
         lam0 = (-b0 * A11 + b1 * A01) / det
         lam1 = (-b1 * A00 + b0 * A01) / det
     lam[0], lam[1] = lam0, lam1
+    w, x, yq, z = y[3], y[4], y[5], y[6]
     dy[0], dy[1], dy[2] = y[7], y[8], y[9]
     dy[3] = 0.5 * (-wx * x - wy * yq - wz * z)
     dy[4] = 0.5 * (wx * w + wy * z - wz * yq)

@@ -33,6 +33,49 @@ def _qmul(a0, a1, a2, a3, b0, b1, b2, b3):
 
 
 @njit(cache=True)
+def rotation_xy(y):
+    """The first two columns of R (body → world) of state y: (R00, R01, R10, R11, R20,
+    R21), the z row from the small quaternion terms directly."""
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    return (
+        1 - 2 * (yq * yq + z * z),
+        2 * (x * yq - w * z),
+        2 * (x * yq + w * z),
+        1 - 2 * (x * x + z * z),
+        2 * (x * z - w * yq),
+        2 * (yq * z + w * x),
+    )
+
+
+@njit(cache=True)
+def free_angular_acceleration(y, i1, i3):
+    """ω̇ without contact forces, −I⁻¹(ω × Iω) for the axisymmetric body, and the body
+    axis e3: (ω̇x, ω̇y, ω̇z, e3x, e3y, e3z)."""
+    w, x, yq, z = y[3], y[4], y[5], y[6]
+    e3x = 2 * (x * z + w * yq)
+    e3y = 2 * (yq * z - w * x)
+    e3z = 1 - 2 * (x * x + yq * yq)
+    wx, wy, wz = y[10], y[11], y[12]
+    w3 = wx * e3x + wy * e3y + wz * e3z
+    Lx = i1 * wx + (i3 - i1) * w3 * e3x
+    Ly = i1 * wy + (i3 - i1) * w3 * e3y
+    Lz = i1 * wz + (i3 - i1) * w3 * e3z
+    gx = wy * Lz - wz * Ly
+    gy = wz * Lx - wx * Lz
+    gz = wx * Ly - wy * Lx
+    f = 1.0 / i3 - 1.0 / i1
+    eg = e3x * gx + e3y * gy + e3z * gz
+    return (
+        -(gx / i1 + f * eg * e3x),
+        -(gy / i1 + f * eg * e3y),
+        -(gz / i1 + f * eg * e3z),
+        e3x,
+        e3y,
+        e3z,
+    )
+
+
+@njit(cache=True)
 def flight_state(y0, LA, lam, g, s, out):
     """Closed-form free flight (reference.flight.free_flight) into `out`."""
     out[0] = y0[0] + y0[7] * s
@@ -205,13 +248,7 @@ def gap_jet_flat(y, pts, acc6, gap, rate, accel, noise):
     """Gap, rate, normal acceleration and gap roundoff of every vertex over flat ground
     (reference.events.gap_jet for n = e_z) into the given arrays: with r = R p,
     g = z + r_z, g′ = v_z + (ω × r)_z, g″ = a_z + (ω̇ × r)_z + (ω·r) ω_z − |ω|² r_z."""
-    w, x, yq, z = y[3], y[4], y[5], y[6]
-    R00 = 1 - 2 * (yq * yq + z * z)
-    R01 = 2 * (x * yq - w * z)
-    R10 = 2 * (x * yq + w * z)
-    R11 = 1 - 2 * (x * x + z * z)
-    R20 = 2 * (x * z - w * yq)
-    R21 = 2 * (yq * z + w * x)
+    R00, R01, R10, R11, R20, R21 = rotation_xy(y)
     wx, wy, wz = y[10], y[11], y[12]
     ww = wx * wx + wy * wy + wz * wz
     for k in range(pts.shape[0]):
@@ -253,13 +290,7 @@ def _window(y, radius, n, K, delta, margin):
     δ, so vertex k is safe over [0, δ] when P2 > 0 at 0 and at δ, i.e. when
     a |u| cos(θ_k − ∠u) > −Z: outside an arc of half-width π − acos(−Z / (a|u|))
     around ∠u + π.  Returns (k0, half); half = n // 2 means every vertex."""
-    w, x, yq, z = y[3], y[4], y[5], y[6]
-    R00 = 1 - 2 * (yq * yq + z * z)
-    R01 = 2 * (x * yq - w * z)
-    R10 = 2 * (x * yq + w * z)
-    R11 = 1 - 2 * (x * x + z * z)
-    R20 = 2 * (x * z - w * yq)
-    R21 = 2 * (yq * z + w * x)
+    R00, R01, R10, R11, R20, R21 = rotation_xy(y)
     A = y[10] * R10 - y[11] * R00
     B = y[10] * R11 - y[11] * R01
     ux, uy = R20 + A * delta, R21 + B * delta
@@ -276,6 +307,15 @@ def _window(y, radius, n, K, delta, margin):
     half = min(half + margin, n // 2)
     k0 = int(math.floor(centre / dth + 0.5))
     return k0, half
+
+
+@njit(cache=True)
+def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
+    """F(x) of _circle_step."""
+    ux, uy = px + x * qx, py + x * qy
+    return (
+        z + x * (vz - x * (0.5 * g + x * B / 6.0)) - math.sqrt(ux * ux + uy * uy) - 0.5 * x * x * rn
+    )
 
 
 @njit(cache=True)
@@ -305,9 +345,7 @@ def _circle_step(y, LA, lam, g, radius, B):
     # an upper end: F → −∞ (g > 0); double until F < 0
     hi = max(f0 / max(abs(vz) + math.sqrt(qx * qx + qy * qy), 1e-300), 1e-300)
     for _ in range(2000):
-        ux, uy = px + hi * qx, py + hi * qy
-        fhi = z + hi * (vz - hi * (0.5 * g + hi * B / 6.0)) - math.sqrt(ux * ux + uy * uy)
-        fhi -= 0.5 * hi * hi * rn
+        fhi = _circle_F(hi, z, vz, g, B, px, py, qx, qy, rn)
         if fhi < 0.0:
             break
         lo, flo = hi, fhi
@@ -315,27 +353,18 @@ def _circle_step(y, LA, lam, g, radius, B):
     for _ in range(100):
         if hi - lo <= 1e-3 * hi:
             break
-        # chord from (lo, F(lo)) to (hi, F(hi)): below F on [lo, hi] (concavity)
-        x = lo + (hi - lo) * flo / (flo - fhi)
-        ux, uy = px + x * qx, py + x * qy
-        un = math.sqrt(ux * ux + uy * uy)
-        fx = z + x * (vz - x * (0.5 * g + x * B / 6.0)) - un - 0.5 * x * x * rn
-        if fx >= 0.0:
-            lo, flo = x, fx
-        else:
-            hi, fhi = x, fx
-        # Newton from the upper end: the tangent lies above F, so it stays above the root
+        # chord from (lo, F(lo)) to (hi, F(hi)): below F on [lo, hi] (concavity);
+        # then Newton from the upper end: the tangent lies above F, so it stays above
+        # the root
         ux, uy = px + hi * qx, py + hi * qy
         un = math.sqrt(ux * ux + uy * uy)
         d = vz - hi * (g + 0.5 * hi * B) - hi * rn
         if un > 0.0:
             d -= (ux * qx + uy * qy) / un
-        if d < 0.0:
-            x = hi - fhi / d
+        newton = hi - fhi / d if d < 0.0 else -1.0
+        for x in (lo + (hi - lo) * flo / (flo - fhi), newton):
             if lo < x < hi:
-                ux, uy = px + x * qx, py + x * qy
-                un = math.sqrt(ux * ux + uy * uy)
-                fx = z + x * (vz - x * (0.5 * g + x * B / 6.0)) - un - 0.5 * x * x * rn
+                fx = _circle_F(x, z, vz, g, B, px, py, qx, qy, rn)
                 if fx >= 0.0:
                     lo, flo = x, fx
                 else:
@@ -659,80 +688,3 @@ def bounce_loop(
         imp[n_imp, 5] = u_post
         n_imp += 1
         ns = _record_sample(y, t_hi, t_lo, mass, i1, i3, g, st, sy, se, ns)
-
-
-# ------------------------------------------------------------------ contact-phase RHS
-
-
-@njit(cache=True)
-def constrained_rhs_flat(y, held_pts, mass, i1, i3, g, dy):
-    """dy/dt with 1 or 2 vertices held on flat ground (reference.contact.constrained_rhs
-    for n = e_z): a_n = A λ + b = 0 solved in closed form for m ≤ 2.  Returns λ."""
-    w, x, yq, z = y[3], y[4], y[5], y[6]
-    e3x = 2 * (x * z + w * yq)
-    e3y = 2 * (yq * z - w * x)
-    e3z = 1 - 2 * (x * x + yq * yq)
-    wx, wy, wz = y[10], y[11], y[12]
-    w3 = wx * e3x + wy * e3y + wz * e3z
-    # L = I ω, gyroscopic −I⁻¹(ω × Iω)
-    Lx = i1 * wx + (i3 - i1) * w3 * e3x
-    Ly = i1 * wy + (i3 - i1) * w3 * e3y
-    Lz = i1 * wz + (i3 - i1) * w3 * e3z
-    gx = wy * Lz - wz * Ly
-    gy = wz * Lx - wx * Lz
-    gz = wx * Ly - wy * Lx
-    f = 1.0 / i3 - 1.0 / i1
-    eg = e3x * gx + e3y * gy + e3z * gz
-    ax0 = -(gx / i1 + f * eg * e3x)
-    ay0 = -(gy / i1 + f * eg * e3y)
-    az0 = -(gz / i1 + f * eg * e3z)
-    m = held_pts.shape[0]
-    cxs = np.empty(2)
-    cys = np.empty(2)
-    icx = np.empty(2)
-    icy = np.empty(2)
-    icz = np.empty(2)
-    b = np.empty(2)
-    for i in range(m):
-        px, py = held_pts[i, 0], held_pts[i, 1]
-        rx = (1 - 2 * (yq * yq + z * z)) * px + 2 * (x * yq - w * z) * py
-        ry = 2 * (x * yq + w * z) * px + (1 - 2 * (x * x + z * z)) * py
-        rz = 2 * (x * z - w * yq) * px + 2 * (yq * z + w * x) * py
-        cx, cy = ry, -rx  # r × e_z
-        ec = e3x * cx + e3y * cy
-        cxs[i], cys[i] = cx, cy
-        icx[i] = cx / i1 + f * ec * e3x
-        icy[i] = cy / i1 + f * ec * e3y
-        icz[i] = f * ec * e3z
-        # b = −g + c·ω̇_free + (ω·r) ω_z − |ω|² r_z
-        b[i] = (
-            -g
-            + cx * ax0
-            + cy * ay0
-            + (wx * rx + wy * ry + wz * rz) * wz
-            - (wx * wx + wy * wy + wz * wz) * rz
-        )
-    lam0 = 0.0
-    lam1 = 0.0
-    if m == 1:
-        A00 = 1.0 / mass + cxs[0] * icx[0] + cys[0] * icy[0]
-        lam0 = -b[0] / A00
-    else:
-        A00 = 1.0 / mass + cxs[0] * icx[0] + cys[0] * icy[0]
-        A11 = 1.0 / mass + cxs[1] * icx[1] + cys[1] * icy[1]
-        A01 = 1.0 / mass + cxs[0] * icx[1] + cys[0] * icy[1]
-        det = A00 * A11 - A01 * A01
-        lam0 = (-b[0] * A11 + b[1] * A01) / det
-        lam1 = (-b[1] * A00 + b[0] * A01) / det
-    dy[0], dy[1], dy[2] = y[7], y[8], y[9]
-    dy[3] = 0.5 * (-wx * x - wy * yq - wz * z)
-    dy[4] = 0.5 * (wx * w + wy * z - wz * yq)
-    dy[5] = 0.5 * (-wx * z + wy * w + wz * x)
-    dy[6] = 0.5 * (wx * yq - wy * x + wz * w)
-    dy[7] = 0.0
-    dy[8] = 0.0
-    dy[9] = -g + (lam0 + lam1) / mass
-    dy[10] = ax0 + icx[0] * lam0 + (icx[1] * lam1 if m == 2 else 0.0)
-    dy[11] = ay0 + icy[0] * lam0 + (icy[1] * lam1 if m == 2 else 0.0)
-    dy[12] = az0 + icz[0] * lam0 + (icz[1] * lam1 if m == 2 else 0.0)
-    return lam0
