@@ -212,7 +212,10 @@ class BodyModel:
 
     def velocity_scale(self, y: np.ndarray) -> float:
         """Largest speed of a body point on the rim: |v| + a|ω| (a local velocity unit)."""
-        return float(np.linalg.norm(y[V]) + self.radius * np.linalg.norm(y[W]))
+        v0, v1, v2, w0, w1, w2 = y[7:13].tolist()
+        return math.sqrt(v0 * v0 + v1 * v1 + v2 * v2) + self.radius * math.sqrt(
+            w0 * w0 + w1 * w1 + w2 * w2
+        )
 
     def length_scale(self, y: np.ndarray) -> float:
         """Local length unit: height of the centre plus the rim's vertical extent."""

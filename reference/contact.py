@@ -59,6 +59,8 @@ def solve_contact_lcp(
         return [], np.zeros(0)
     A, b, *_ = contact_system(model, y, candidates)
     m = len(candidates)
+    if m <= 2:
+        return _lcp_small(candidates, A, b, tol)
     best = None
     for size in range(m, -1, -1):
         for S in itertools.combinations(range(m), size):
@@ -83,6 +85,43 @@ def solve_contact_lcp(
     S, lam = best
     active = [candidates[i] for i in S if lam[i] > 0.0]
     return active, np.array([lam[i] for i in S if lam[i] > 0.0])
+
+
+def _lcp_small(candidates: list[int], A: np.ndarray, b: np.ndarray, tol: float):
+    """solve_contact_lcp's enumeration written out for one or two candidates, in the
+    same order (both, then each alone, then none), with Cramer's rule for the 2 × 2."""
+    a = A.tolist()
+    bb = b.tolist()
+
+    def ok(lam: float) -> bool:
+        return lam >= -tol * (1 + abs(lam))
+
+    def result(pairs):
+        active = [c for c, lam in pairs if lam > 0.0]
+        return active, np.array([lam for _, lam in pairs if lam > 0.0])
+
+    if len(candidates) == 1:
+        lam = -bb[0] / a[0][0]
+        if ok(lam):
+            return result([(candidates[0], lam)])
+        if bb[0] >= 0.0:
+            return [], np.zeros(0)
+        raise RuntimeError("contact complementarity problem has no solution")
+    det = a[0][0] * a[1][1] - a[0][1] * a[1][0]
+    if det != 0.0:
+        l0 = (-bb[0] * a[1][1] + bb[1] * a[0][1]) / det
+        l1 = (-bb[1] * a[0][0] + bb[0] * a[1][0]) / det
+        if ok(l0) and ok(l1):
+            return result([(candidates[0], l0), (candidates[1], l1)])
+    for i, j in ((0, 1), (1, 0)):
+        if a[i][i] == 0.0:
+            continue
+        lam = -bb[i] / a[i][i]
+        if ok(lam) and a[j][i] * lam + bb[j] >= 0.0:
+            return result([(candidates[i], lam)])
+    if bb[0] >= 0.0 and bb[1] >= 0.0:
+        return [], np.zeros(0)
+    raise RuntimeError("contact complementarity problem has no solution")
 
 
 def constrained_rhs(model: BodyModel, contacts: list[int], compiled: bool = True):

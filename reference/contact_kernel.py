@@ -183,12 +183,25 @@ def project_held(y, held, mass, i1, i3):
             nq = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
             y[3], y[4], y[5], y[6] = q0 / nq, q1 / nq, q2 / nq, q3 / nq
     # velocities: zero normal velocity at the held vertices
-    w, x, yq, z = y[3], y[4], y[5], y[6]
+    normal_impulses(y, held, mass, i1, i3, np.zeros(m))
+
+
+@njit(cache=True)
+def normal_impulses(y, held, mass, i1, i3, target):
+    """Normal impulses at the held vertices (1 or 2) that set their normal velocities to
+    `target`, in place (reference.impact.apply_normal_impulses for flat ground):
+    Δ(v, ω) = M⁻¹ Jᵀ A⁻¹ (target − v_n)."""
+    m = held.shape[0]
+    cols = np.empty((2, 6))
+    A = np.empty((2, 2))
+    r = np.empty(2)
+    mu = np.empty(2)
+    R00, R01, R10, R11, R20, R21 = rotation_xy(y)
     for i in range(m):
         px, py = held[i, 0], held[i, 1]
-        rx = (1 - 2 * (yq * yq + z * z)) * px + 2 * (x * yq - w * z) * py
-        ry = 2 * (x * yq + w * z) * px + (1 - 2 * (x * x + z * z)) * py
-        r[i] = -(y[9] + (y[10] * ry - y[11] * rx))
+        rx = R00 * px + R01 * py
+        ry = R10 * px + R11 * py
+        r[i] = target[i] - (y[9] + (y[10] * ry - y[11] * rx))
     _impulse_directions(y, held, mass, i1, i3, cols, A)
     _solve_held(A, r, m, mu)
     for i in range(m):
@@ -196,6 +209,33 @@ def project_held(y, held, mass, i1, i3):
         y[10] += cols[i, 3] * mu[i]
         y[11] += cols[i, 4] * mu[i]
         y[12] += cols[i, 5] * mu[i]
+
+
+@njit(cache=True)
+def impact_flat(y, pts, mass, i1, i3, gamma, vn_post):
+    """Newtonian impact of the vertex pts[0] on flat ground, in place
+    (reference.impact.impact_impulse): ζ = −(1 + γ) u⁻ / (J M⁻¹ Jᵀ) along J = [e_z,
+    r × e_z]; vn_post receives the normal velocities of all rows of pts afterwards.
+    Returns (ζ, u⁻)."""
+    cols = np.empty((2, 6))
+    A = np.empty((2, 2))
+    R00, R01, R10, R11, R20, R21 = rotation_xy(y)
+    px, py = pts[0, 0], pts[0, 1]
+    rx = R00 * px + R01 * py
+    ry = R10 * px + R11 * py
+    u_pre = y[9] + (y[10] * ry - y[11] * rx)
+    _impulse_directions(y, pts[:1], mass, i1, i3, cols, A)
+    zeta = -(1.0 + gamma) * u_pre / A[0, 0]
+    y[9] += cols[0, 2] * zeta
+    y[10] += cols[0, 3] * zeta
+    y[11] += cols[0, 4] * zeta
+    y[12] += cols[0, 5] * zeta
+    for j in range(pts.shape[0]):
+        px, py = pts[j, 0], pts[j, 1]
+        rx = R00 * px + R01 * py
+        ry = R10 * px + R11 * py
+        vn_post[j] = y[9] + (y[10] * ry - y[11] * rx)
+    return zeta, u_pre
 
 
 @njit(cache=True)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import body as body_mod
 from .body import NEAR_GROUND_ALL, BodyModel, V, X
 from .flight import FlightConstants, flight_acceleration, free_flight
 
@@ -40,12 +41,17 @@ def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray, idx=None) -> GapJ
     """g, g′ = J u, g″ = J [v̇; ω̇] + bias for the contacts `idx` (every contact by
     default), at state y with accelerations acc6.  Large polygons over flat ground
     use the compiled loop (reference.flight_kernel.gap_jet_flat)."""
-    n = model.n_contacts
-    if idx is None and model.flat and n > NEAR_GROUND_ALL:
+    if model.flat and (
+        body_mod.COMPILED_KINEMATICS or (idx is None and model.n_contacts > NEAR_GROUND_ALL)
+    ):
         from .flight_kernel import gap_jet_flat
 
+        pts = model.points if idx is None else np.ascontiguousarray(model.points[idx])
+        n = len(pts)
         gap, vn, accel, noise = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-        gap_jet_flat(y, model.points, np.asarray(acc6, dtype=float), gap, vn, accel, noise)
+        gap_jet_flat(
+            np.asarray(y, dtype=float), pts, np.asarray(acc6, dtype=float), gap, vn, accel, noise
+        )
         rn = np.full_like(vn, 64 * np.finfo(float).eps * model.velocity_scale(y))
         return GapJet(gap, vn, accel, noise, rn)
     gap, normal, lever, vn, noise = model.contacts(y, idx)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import body as body_mod
 from .body import BodyModel, Q, V, W
 
 
@@ -38,6 +39,16 @@ def impact_impulse(
     (all contacts when None; NaN for the unwatched), so a caller that needs only the
     resting ones does not pay for every vertex of a large polygon."""
     idx = np.arange(model.n_contacts) if watch is None else np.array([k, *watch], dtype=int)
+    if model.flat and body_mod.COMPILED_KINEMATICS and watch is not None:
+        from .contact_kernel import impact_flat
+
+        y_post = np.array(y, dtype=float)
+        vn_idx = np.empty(len(idx))
+        zeta, u_pre = impact_flat(y_post, model.points[idx], model.mass, model.i1, model.i3,
+                                  float(gamma), vn_idx)  # fmt: skip
+        vn_post = np.full(model.n_contacts, np.nan)
+        vn_post[idx] = vn_idx
+        return ImpactResult(y_post, float(zeta), float(u_pre), float(vn_idx[0]), vn_post)
     gap, normal, lever, vn, _ = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])
@@ -65,6 +76,14 @@ def apply_normal_impulses(
     momentum and vertical angular momentum are untouched on flat ground."""
     if not contacts:
         return y
+    if model.flat and body_mod.COMPILED_KINEMATICS and len(contacts) <= 2:
+        from .contact_kernel import normal_impulses
+
+        out = np.array(y, dtype=float)
+        held = np.ascontiguousarray(model.points[list(contacts)])
+        normal_impulses(out, held, model.mass, model.i1, model.i3,
+                        np.asarray(target_vn, dtype=float))  # fmt: skip
+        return out
     gap, normal, lever, vn, _ = model.contacts(y, np.asarray(contacts, dtype=int))
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])

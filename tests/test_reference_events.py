@@ -95,11 +95,12 @@ def test_no_builtin_scene_penetrates_beyond_1e_12(name):
         assert model.contacts(y)[0].min() >= -1e-12
 
 
-def test_compiled_gap_jet_of_a_large_polygon_equals_the_array_expression():
-    """Polygons with n > 64 get their gap jets from a compiled loop in contact phases;
-    it must equal the J·acc + bias array expression used for every other case."""
+def test_compiled_gap_jet_of_a_large_polygon_equals_the_array_expression(monkeypatch):
+    """Gap jets over flat ground come from a compiled loop; they must equal the
+    J·acc + bias array expression (reference.body.COMPILED_KINEMATICS = False)."""
     import numpy as np
 
+    import reference.body as body_mod
     from reference.body import BodyModel, initial_state
     from reference.events import gap_jet
     from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear
@@ -118,6 +119,12 @@ def test_compiled_gap_jet_of_a_large_polygon_equals_the_array_expression():
     y[10:13] = (0.3, -0.2, 0.7)
     acc = np.array([0.1, 0.2, -0.9, 0.3, 0.4, 0.5])
     fast = gap_jet(model, y, acc)
+    fast_idx = gap_jet(model, y, acc, [3, 500, 999])
+    monkeypatch.setattr(body_mod, "COMPILED_KINEMATICS", False)
     slow = gap_jet(model, y, acc, np.arange(1000))  # the array expression
+    for f in ("gap", "rate", "accel", "noise"):
+        np.testing.assert_allclose(
+            getattr(fast_idx, f), getattr(slow, f)[[3, 500, 999]], rtol=0, atol=1e-15
+        )
     for f in ("gap", "rate", "accel", "noise", "rate_noise"):
         np.testing.assert_allclose(getattr(fast, f), getattr(slow, f), rtol=0, atol=1e-15)
