@@ -405,8 +405,16 @@ def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float
         h = min(h, remaining - s_done)
         if h <= 0:
             _close_contact_phase(run, t0, active, E_start, y)
-            run.clock.add(0.0)
-            return None
+            if remaining - s_done <= 0:
+                return None
+            # a zero chunk before t_end: some contact sits on the ground with no event
+            # the model recognises; say so rather than end as if t_end were reached
+            return (
+                Status.FAILED,
+                f"contact phase cannot advance at t = {run.clock.hi:.17g} "
+                f"(chunk horizon {h:g} with contacts {active} held)",
+                None,
+            )
         y_new, sol, nfev = integrate_chunk(model, y, active, h, run.opts.contact_rtol, dense=True)
         run.stats["contact_chunks"] += 1
         run.stats["contact_rhs_evals"] += nfev
