@@ -417,13 +417,15 @@ def contact_loop(
     chunks = 0
     nfev = 0
     ns = 0
+    fresh = False  # lam and the jets are those of y already (from the last chunk's end)
     while True:
         if ns + 8 >= st.shape[0]:
             return EXIT_FULL, y, t_hi, t_lo, s_done, chunks, nfev, ns, h_prev
-        held_rhs(y, held, mass, i1, i3, g, dy, lam)
-        for c in range(6):
-            acc6[c] = dy[7 + c]
-        gap_jet_flat(y, pts, acc6, gap, rate, accel, noise)
+        if not fresh:
+            held_rhs(y, held, mass, i1, i3, g, dy, lam)
+            for c in range(6):
+                acc6[c] = dy[7 + c]
+            gap_jet_flat(y, pts, acc6, gap, rate, accel, noise)
         vs = math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + radius * math.sqrt(
             y[10] ** 2 + y[11] ** 2 + y[12] ** 2
         )
@@ -493,7 +495,10 @@ def contact_loop(
             if lam_new[i] < 0:
                 redo = True
         if not redo:
-            # every vertex below the ground at the chunk's end, not held
+            # every vertex below the ground at the chunk's end, not held (the jets are
+            # the next chunk's too)
+            for c in range(6):
+                acc6[c] = dy[7 + c]
             gap_jet_flat(y_new, pts, acc6, gap, rate, accel, noise)
             for k in range(n):
                 if not is_held[k] and gap[k] < -max(noise[k], gap_res):
@@ -509,6 +514,8 @@ def contact_loop(
         s_done += h
         y[:] = y_new
         lam_prev[0], lam_prev[1] = lam_new[0], lam_new[1]
+        lam[0], lam[1] = lam_new[0], lam_new[1]
+        fresh = True
         h_prev = h
         if left - s_done <= 0:
             return EXIT_T_END, y, t_hi, t_lo, s_done, chunks, nfev, ns, h_prev

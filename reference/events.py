@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import body as body_mod
-from .body import NEAR_GROUND_ALL, BodyModel, V, X
+from .body import BodyModel, V, X
 from .flight import FlightConstants, flight_acceleration, free_flight
 
 
@@ -39,11 +39,9 @@ class GapJet:
 
 def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray, idx=None) -> GapJet:
     """g, g′ = J u, g″ = J [v̇; ω̇] + bias for the contacts `idx` (every contact by
-    default), at state y with accelerations acc6.  Large polygons over flat ground
-    use the compiled loop (reference.flight_kernel.gap_jet_flat)."""
-    if model.flat and (
-        body_mod.COMPILED_KINEMATICS or (idx is None and model.n_contacts > NEAR_GROUND_ALL)
-    ):
+    default), at state y with accelerations acc6.  Over flat ground the compiled loop
+    (reference.flight_kernel.gap_jet_flat) evaluates the same expressions."""
+    if model.flat and body_mod.COMPILED_KINEMATICS:
         from .flight_kernel import gap_jet_flat
 
         pts = model.points if idx is None else np.ascontiguousarray(model.points[idx])

@@ -412,6 +412,38 @@ def _window_step(y, g, LA, lam, pts, n, K, B, k0, half, rate_noise, res):
 
 
 @njit(cache=True)
+def _near_vertices_step(y, g, LA, lam, pts, radius, n, K, B, left, last_dlt, rate_noise, res):
+    """Examine the vertices near the lowest direction (n > SMALL_N) into res (see
+    _vertex_step) and return the cap on the step they certify (inf when none is needed).
+
+    The touching/lowest vertices and WINDOW_MAX more on each side come first.  The step
+    they allow, δ, holds for all other vertices if those outside window(δ) are safe by P2
+    and those inside have been examined: at most WINDOW_MAX more are examined, δ being
+    shortened (from 4× the last certified step) until that suffices."""
+    k0, h0 = _window(y, radius, n, K, 0.0, 2)
+    h = min(h0 + WINDOW_MAX, n // 2)
+    _window_step(y, g, LA, lam, pts, n, K, B, k0, h, rate_noise, res)
+    if res[2] >= 0 or res[3] >= 0 or 2 * h + 1 >= n:
+        return math.inf
+    dlt = min(res[0], left, 4.0 * last_dlt)
+    while True:
+        k1, h1 = _window(y, radius, n, K, dlt, 3)
+        d = (k1 - k0) % n
+        if d > n // 2:
+            d -= n
+        lo1, hi1 = d - h1, d + h1  # window(δ) in offsets from k0
+        extra = max(hi1 - h, 0) + max(-h - lo1, 0)
+        if 2 * h1 + 1 < n and extra <= WINDOW_MAX:
+            break
+        dlt *= 0.25
+    for off in range(h + 1, hi1 + 1):
+        _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
+    for off in range(lo1, -h):
+        _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
+    return dlt
+
+
+@njit(cache=True)
 def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, out_y):
     """First vertex reached (approaching) in a free flight of at most `horizon`.
 
@@ -445,38 +477,13 @@ def search_flat(y0, LA, lam, g, pts, radius, K, B, vscale, horizon, max_iter, ou
             # direction must be examined
             d_c, f0, pn = _circle_step(y, LA, lam, g, radius, B)
             if f0 > 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (abs(y[2]) + radius):
-                step = max(d_c, 1e-15 * max(s, 1e-300))
-                if s + step >= horizon:
-                    flight_state(y0, LA, lam, g, horizon, y)
-                    return horizon, -1, it, 0, -1, 0
-                s += step
-                flight_state(y0, LA, lam, g, s, y)
-                continue
-            # the touching/lowest vertices and WINDOW_MAX more on each side first
-            k0, h0 = _window(y, radius, n, K, 0.0, 2)
-            h = min(h0 + WINDOW_MAX, n // 2)
-            _window_step(y, g, LA, lam, pts, n, K, B, k0, h, rate_noise, res)
-            if res[2] < 0 and res[3] < 0 and 2 * h + 1 < n:
-                # the step they allow, δ, holds for all other vertices if those outside
-                # window(δ) are safe by P2 and those inside have been examined: examine
-                # at most WINDOW_MAX more, shortening δ until that suffices
-                dlt = min(res[0], horizon - s, 4.0 * last_dlt)  # start near the last
-                while True:
-                    k1, h1 = _window(y, radius, n, K, dlt, 3)
-                    d = (k1 - k0) % n
-                    if d > n // 2:
-                        d -= n
-                    lo1, hi1 = d - h1, d + h1  # window(δ) in offsets from k0
-                    extra = max(hi1 - h, 0) + max(-h - lo1, 0)
-                    if 2 * h1 + 1 < n and extra <= WINDOW_MAX:
-                        break
-                    dlt *= 0.25
-                for off in range(h + 1, hi1 + 1):
-                    _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
-                for off in range(lo1, -h):
-                    _vertex_step(y, g, LA, lam, pts, (k0 + off) % n, K, B, rate_noise, res)
-                cap_step = dlt
-                last_dlt = dlt
+                cap_step = 0.0  # no vertex examined: the circle's step alone
+            else:
+                cap_step = _near_vertices_step(
+                    y, g, LA, lam, pts, radius, n, K, B, horizon - s, last_dlt, rate_noise, res
+                )
+                if cap_step < math.inf:
+                    last_dlt = cap_step
         hit_k, land_k = int(res[2]), int(res[3])
         if hit_k >= 0:
             s_hit = s + res[1]

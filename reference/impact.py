@@ -39,9 +39,11 @@ def impact_impulse(
     (all contacts when None; NaN for the unwatched), so a caller that needs only the
     resting ones does not pay for every vertex of a large polygon."""
     idx = np.arange(model.n_contacts) if watch is None else np.array([k, *watch], dtype=int)
-    if model.flat and body_mod.COMPILED_KINEMATICS and watch is not None:
+    if model.flat and body_mod.COMPILED_KINEMATICS:
         from .contact_kernel import impact_flat
 
+        if watch is None:  # the hitting vertex first
+            idx = np.concatenate(([k], np.delete(idx, k)))
         y_post = np.array(y, dtype=float)
         vn_idx = np.empty(len(idx))
         zeta, u_pre = impact_flat(y_post, model.points[idx], model.mass, model.i1, model.i3,

@@ -112,6 +112,12 @@ class _Run:
         m = self.model
         self.buf.add(c.hi, c.lo, y, m.kinetic_energy(y), m.potential_energy(y))
 
+    def sample_block(self, st: np.ndarray, sy: np.ndarray, se: np.ndarray, ns: int) -> None:
+        """Record the first ns samples a compiled loop wrote (times, states, energies),
+        as many as max_samples leaves room for."""
+        k = min(ns, max(self.opts.max_samples - len(self.buf), 0))
+        self.buf.extend(st[:k], sy[:k], se[:k])
+
 
 def excess_energy(model: BodyModel, y: np.ndarray) -> float:
     """Energy above the lowest level the invariants allow (body flat on the ground):
@@ -329,9 +335,7 @@ def _bounce_compiled(run: _Run, y: np.ndarray) -> tuple[bool, np.ndarray]:
         )
         run.stats["bounce_loop_impacts"] = run.stats.get("bounce_loop_impacts", 0) + int(n_imp)
         run.impacts.extend_rows(imp[:n_imp])
-        room = max(run.opts.max_samples - len(run.buf), 0)
-        k = min(ns, room)
-        run.buf.extend(st[:k], sy[:k], se[:k])
+        run.sample_block(st, sy, se, ns)
         run.clock.hi, run.clock.lo = float(hi), float(lo)
         if n_imp:
             run.phases.append(Phase(t0, run.clock.hi, "flight"))
@@ -514,8 +518,7 @@ def _contact_compiled(run: _Run, y, active, left, gap_res, lam_prev, h_prev):
         run.stats["compiled_contact_chunks"] = run.stats.get("compiled_contact_chunks", 0) + int(
             chunks
         )
-        k = min(ns, max(run.opts.max_samples - len(run.buf), 0))
-        run.buf.extend(st[:k], sy[:k], se[:k])
+        run.sample_block(st, sy, se, ns)
         run.clock.hi, run.clock.lo = float(hi), float(lo)
         s_total += ds
         if code != ck.EXIT_FULL:
