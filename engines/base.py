@@ -166,18 +166,15 @@ def build_trajectory(
     ke, pe = energies(scene, S)
     stats = dict(stats)
     stats["min_gap"] = float(gaps.min()) if gaps.size else None
-    return Trajectory(
-        engine=engine,
-        scene=scene.name,
-        t=t[keep],
-        position=S[:, 0:3],
-        quaternion=S[:, 3:7],
-        velocity=S[:, 7:10],
-        angular_velocity=S[:, 10:13],
-        kinetic_energy=ke,
-        potential_energy=pe,
-        impacts=impacts,
-        status=status,
+    return Trajectory.from_states(
+        engine,
+        scene.name,
+        t[keep],
+        S,
+        ke,
+        pe,
+        impacts,
+        status,
         message=message,
         t_final=float(t[-1]) if len(t) else 0.0,
         stats=stats,

@@ -161,20 +161,17 @@ def simulate(
     run.stats["n_impacts"] = len(run.impacts)
     n = len(run.impacts)
     run.stats["impacts_per_s"] = n / run.stats["wall_time_s"] if n else 0.0
-    return Trajectory(
-        engine="reference",
-        scene=scene.name,
-        t=arrays["t"],
+    return Trajectory.from_states(
+        "reference",
+        scene.name,
+        arrays["t"],
+        arrays["states"],
+        arrays["kinetic_energy"],
+        arrays["potential_energy"],
+        run.impacts,
+        status,
         t_lo=arrays["t_lo"],
-        position=arrays["position"],
-        quaternion=arrays["quaternion"],
-        velocity=arrays["velocity"],
-        angular_velocity=arrays["angular_velocity"],
-        kinetic_energy=arrays["kinetic_energy"],
-        potential_energy=arrays["potential_energy"],
-        impacts=run.impacts,
         phases=run.phases,
-        status=status,
         message=message,
         t_final=run.clock.hi,
         t_singularity=t_sing,

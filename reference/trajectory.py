@@ -85,21 +85,41 @@ class Trajectory:
     @classmethod
     def failed(cls, engine: str, scene: str, dt: float | None, message: str) -> Trajectory:
         """An empty run with status `failed`: what a simulator that raised produced."""
-        empty3 = np.zeros((0, 3))
+        empty = np.zeros(0)
+        return cls.from_states(
+            engine, scene, empty, np.zeros((0, 13)), empty, empty, [], Status.FAILED,
+            message=message, dt=dt,
+        )  # fmt: skip
+
+    @classmethod
+    def from_states(
+        cls,
+        engine: str,
+        scene: str,
+        t: np.ndarray,
+        states: np.ndarray,
+        kinetic_energy: np.ndarray,
+        potential_energy: np.ndarray,
+        impacts: Sequence[ImpactEvent],
+        status: Status,
+        **fields: Any,
+    ) -> Trajectory:
+        """A Trajectory from rows of the 13-component state (x, q wxyz, v, ω) at times
+        t; `fields` are the other attributes (message, t_final, phases, stats, …)."""
+        S = np.asarray(states, dtype=float).reshape(-1, 13)
         return cls(
             engine=engine,
             scene=scene,
-            t=np.zeros(0),
-            position=empty3,
-            quaternion=np.zeros((0, 4)),
-            velocity=empty3,
-            angular_velocity=empty3,
-            kinetic_energy=np.zeros(0),
-            potential_energy=np.zeros(0),
-            impacts=[],
-            status=Status.FAILED,
-            message=message,
-            dt=dt,
+            t=np.asarray(t, dtype=float),
+            position=S[:, 0:3],
+            quaternion=S[:, 3:7],
+            velocity=S[:, 7:10],
+            angular_velocity=S[:, 10:13],
+            kinetic_energy=np.asarray(kinetic_energy, dtype=float),
+            potential_energy=np.asarray(potential_energy, dtype=float),
+            impacts=impacts,
+            status=status,
+            **fields,
         )
 
     @property
@@ -214,15 +234,13 @@ class SampleBuffer:
         self.n += k
 
     def arrays(self) -> dict[str, np.ndarray]:
+        """Copies of the samples so far: t, t_lo, states (n, 13), kinetic and potential
+        energy."""
         n = self.n
-        Y = self._y[:n].copy()
         return {
             "t": self._t[:n, 0].copy(),
             "t_lo": self._t[:n, 1].copy(),
-            "position": Y[:, 0:3],
-            "quaternion": Y[:, 3:7],
-            "velocity": Y[:, 7:10],
-            "angular_velocity": Y[:, 10:13],
+            "states": self._y[:n].copy(),
             "kinetic_energy": self._e[:n, 0].copy(),
             "potential_energy": self._e[:n, 1].copy(),
         }

@@ -53,5 +53,5 @@ def test_sample_buffer_keeps_rows_in_order_across_single_and_block_appends():
     assert len(buf) == 12
     np.testing.assert_array_equal(a["t"], np.arange(12.0))
     assert a["t_lo"][0] == 1e-20
-    np.testing.assert_array_equal(a["position"][:, 0], np.arange(12.0))
-    np.testing.assert_array_equal(a["angular_velocity"][:, 2], 12.0 + np.arange(12.0))
+    np.testing.assert_array_equal(a["states"][:, 0], np.arange(12.0))
+    np.testing.assert_array_equal(a["states"][:, 12], 12.0 + np.arange(12.0))
