@@ -35,6 +35,14 @@ def _plt():
     return plt
 
 
+def _save(fig, path: Path, dpi: int = 120) -> Path:
+    """Write the figure (tight layout) to path and free it."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    _plt().close(fig)
+    return path
+
+
 def _solutions(n: int, rho: float, gamma: float):
     return selfsimilar_solutions(LinearModel.polygon(n, rho, gamma))
 
@@ -86,10 +94,7 @@ def fig_beta_vs_rho(out: Path, progress) -> dict:
                 float(r) for r, ss in zip(rhos, sols, strict=True) if any(s.feasible for s in ss)
             ],
         }
-    path = out / "beta_vs_rho.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = _save(fig, out / "beta_vs_rho.png")
     f3, f25 = facts[3], facts[25]
     ours = (
         f"trivial solutions at small ρ: {f3['trivial_at_small_rho']} (n=3), "
@@ -129,10 +134,7 @@ def fig_feasibility_border(out: Path, progress) -> dict:
     ax.set_ylabel("smallest ρ with a feasible self-similar motion (γ = 0)")
     ax.set_title("feasible above the curve (grid step 0.01)")
     ax.legend(fontsize=8)
-    path = out / "feasibility_border.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = _save(fig, out / "feasibility_border.png")
     ok = all(b < 0.5 for n, b in zip(ns, border, strict=True) if n > 3)
     return {
         "path": str(path),
@@ -155,10 +157,7 @@ def fig_beta_vs_gamma(out: Path, progress) -> dict:
         ax.set_title(f"n = {n}, ρ = {rho}")
         multi += [(n, rho, float(g)) for g, ss in zip(gammas, sols, strict=True) if len(ss) > 1]
     _legend(axes.flat[0])
-    path = out / "beta_vs_gamma.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = _save(fig, out / "beta_vs_gamma.png")
     return {
         "path": str(path),
         "paper": "trivial solutions for small ρ and γ, feasible or infeasible nontrivial "
@@ -204,10 +203,7 @@ def fig_boundaries(out: Path, progress) -> dict:
     ax.set_xlabel("γ")
     ax.set_ylabel("ρ")
     ax.legend(fontsize=7, loc="upper right")
-    path = out / "boundaries.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = _save(fig, out / "boundaries.png")
     return {
         "path": str(path),
         "paper": "γ = 0: feasible self-similar motion is always stable; ρ = 0.5: unstable "
@@ -250,10 +246,7 @@ def fig_energy_precession(out: Path, progress) -> dict:
         ax.set_ylabel("energy before impact")
         cs.append((n, g, ex["c"], ex["c_decades"]))
     axes.flat[0].legend(fontsize=7)
-    path = out / "energy_precession.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    path = _save(fig, out / "energy_precession.png", dpi=110)
     worst = max(abs(c - 2) for _, _, c, _ in cs)
     return {
         "path": str(path),
@@ -293,10 +286,7 @@ def fig_rod_clin(out: Path, progress) -> dict:
     ax.set_xlabel("γ")
     ax.set_ylabel("ψ = (1 − ρ²)/(1 + ρ²)")
     ax.legend(fontsize=7, loc="lower right")
-    path = out / "rod_clin.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = _save(fig, out / "rod_clin.png")
     # checks: on Or's boundary c_lin = 2; near the CC boundary large; small at γ, ρ → 0
     g = 0.3
     psi_or = (g ** (1 / 3) + g ** (2 / 3)) / (1 + g)
@@ -366,10 +356,7 @@ def fig_triangle_c_vs_clin(out: Path, progress, samples: int = 20) -> dict:
     ax.set_xlabel("γ")
     ax.set_ylabel("c")
     ax.legend(fontsize=7)
-    path = out / "triangle_c_vs_clin.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    path = _save(fig, out / "triangle_c_vs_clin.png")
     rel = [abs(c - cl) / cl for _, _, c, cl, _ in rows]
     rel_long = [abs(c - cl) / cl for _, _, c, cl in long_rows]
     ours = (

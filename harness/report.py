@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from reference.linear._text import table  # noqa: F401  (the one table formatter)
 from reference.trajectory import Trajectory
 
 
@@ -26,11 +27,3 @@ def format_simulate(traj: Trajectory) -> str:
         for ev in traj.impacts[:8]:
             lines.append(f"  {ev.t:.15f}  {ev.contact:4d}  {ev.impulse:.6e}")
     return "\n".join(lines)
-
-
-def table(rows: list[list[str]], header: list[str]) -> str:
-    widths = [max(len(str(x)) for x in col) for col in zip(header, *rows, strict=False)]
-    fmt = "  ".join(f"{{:>{w}}}" for w in widths)
-    out = [fmt.format(*header), fmt.format(*["-" * w for w in widths])]
-    out += [fmt.format(*[str(x) for x in r]) for r in rows]
-    return "\n".join(out)

@@ -59,23 +59,25 @@ SPINNING = full_state((0.1, -0.2, 0.9), (0.3, -0.5, 1.1), (0.2, 0.1, -0.3), (0.7
 
 
 # ------------------------------------------------------------------ state conventions
-def test_initial_state_read_back_from_mujoco_kinematics_equals_reference():
+def _spinning_in_mujoco():
+    """(scene, y0, model, data) with the SPINNING state set in MuJoCo."""
     scene = make_scene(SPINNING)
     y0 = initial_state(scene)
     model = load_model(scene, 1e-4)
     data = mujoco.MjData(model)
     set_state(model, data, y0)
+    return scene, y0, model, data
+
+
+def test_initial_state_read_back_from_mujoco_kinematics_equals_reference():
+    _, y0, model, data = _spinning_in_mujoco()
     # MuJoCo's own world-frame kinematics (xpos, xquat, mj_objectVelocity)
     np.testing.assert_allclose(state_from_kinematics(model, data), y0, rtol=0, atol=1e-12)
     np.testing.assert_allclose(from_mujoco_state(data.qpos, data.qvel), y0, rtol=0, atol=1e-12)
 
 
 def test_free_joint_angular_velocity_is_stored_in_the_body_frame():
-    scene = make_scene(SPINNING)
-    y0 = initial_state(scene)
-    model = load_model(scene, 1e-4)
-    data = mujoco.MjData(model)
-    set_state(model, data, y0)
+    scene, _, _, data = _spinning_in_mujoco()
     R = rodrigues(scene.initial.rotation_vector)
     w_world = np.array(scene.initial.angular_velocity)
     np.testing.assert_allclose(data.qvel[3:6], R.T @ w_world, rtol=0, atol=1e-12)

@@ -161,6 +161,17 @@ def _energy(q, p, thd, mass, g):
 
 
 @njit(cache=True)
+def _closed_indices(closed, nc, cidx):
+    """The closed contacts' indices into cidx; returns how many."""
+    ncl = 0
+    for c in range(nc):
+        if closed[c]:
+            cidx[ncl] = c
+            ncl += 1
+    return ncl
+
+
+@njit(cache=True)
 def _held_solve(F, tinv, g, closed_idx, m, acc, held):
     """Admissible held subset B of the closed contacts (m ≤ 2): the LCP
     F_B Θ⁻¹ F_Bᵀ η = g 1, η ≥ 0, and no closed contact outside B with negative normal
@@ -608,11 +619,7 @@ def simulate_kernel(
             continue
 
         # ---------------------------------------------------------- held set
-        ncl = 0
-        for c in range(nc):
-            if closed[c]:
-                cidx[ncl] = c
-                ncl += 1
+        ncl = _closed_indices(closed, nc, cidx)
         if ncl >= rank_f:
             status = SINGULARITY
             reason = 7
@@ -639,11 +646,7 @@ def simulate_kernel(
                         added = True
             if not added:
                 break
-            ncl = 0
-            for c in range(nc):
-                if closed[c]:
-                    cidx[ncl] = c
-                    ncl += 1
+            ncl = _closed_indices(closed, nc, cidx)
             if ncl >= rank_f:
                 status = SINGULARITY
                 reason = 7

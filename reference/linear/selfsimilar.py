@@ -145,14 +145,22 @@ def _first_root(g: float, v: float, a: float) -> float:
     return first_hit(g, v, a)
 
 
-def reduced_map(model: LinearModel, p: np.ndarray, q: np.ndarray):
-    """C̄(p, q) = T1(C0(p, q)) (eq. barC, appendix B); returns (p̄', q̄', τ)."""
+def _impact_then_flight(model: LinearModel, p: np.ndarray, q: np.ndarray):
+    """The steps shared by C̄ and its Jacobian: impact p_a = U0 p, then smooth motion
+    with acceleration a until contact 1 reaches the ground at τ (f1·q_b = 0).
+    Returns (U0, R⁻¹, f1, a, p_a, τ, p_b, q_b)."""
     U0, Ri, f1 = model.U(0), model.R.T, model.F[1]
     a = smooth_acceleration(model)
     pa = U0 @ p
     tau = _first_root(float(f1 @ q), float(f1 @ pa), float(f1 @ a))
     pb = pa + a * tau
     qb = q + pa * tau + 0.5 * a * tau * tau
+    return U0, Ri, f1, a, pa, tau, pb, qb
+
+
+def reduced_map(model: LinearModel, p: np.ndarray, q: np.ndarray):
+    """C̄(p, q) = T1(C0(p, q)) (eq. barC, appendix B); returns (p̄', q̄', τ)."""
+    _, Ri, _, _, _, tau, pb, qb = _impact_then_flight(model, p, q)
     nb = float(np.linalg.norm(pb))
     return Ri @ pb / nb, Ri @ qb / (nb * nb), tau
 
@@ -161,12 +169,7 @@ def reduced_map_jacobian(model: LinearModel, p: np.ndarray, q: np.ndarray) -> np
     """Closed-form 6×6 Jacobian of C̄ with respect to (p, q) (module docstring):
     dτ = −(f1ᵀdq + τ f1ᵀU0 dp) / f1ᵀp_b, dp_b = U0 dp + a dτ, dq_b = dq + τ U0 dp + p_b dτ,
     d(p_b/|p_b|) = (dp_b − p̂ p̂ᵀdp_b)/|p_b|, d(q_b/|p_b|²) = dq_b/|p_b|² − 2 q_b p_bᵀdp_b/|p_b|⁴."""
-    U0, Ri, f1 = model.U(0), model.R.T, model.F[1]
-    a = smooth_acceleration(model)
-    pa = U0 @ p
-    tau = _first_root(float(f1 @ q), float(f1 @ pa), float(f1 @ a))
-    pb = pa + a * tau
-    qb = q + pa * tau + 0.5 * a * tau * tau
+    U0, Ri, f1, a, pa, tau, pb, qb = _impact_then_flight(model, p, q)
     D = float(f1 @ pb)
     # dτ = g_p·dp + g_q·dq
     g_p = -tau * (f1 @ U0) / D
