@@ -183,7 +183,7 @@ def _load(args):
 
 
 def cmd_simulate(args) -> int:
-    from .report import format_simulate
+    from .text import format_simulate
     from .simulators import check_engine, run_simulator
 
     check_engine(args.engine)

@@ -18,8 +18,8 @@ import pytest
 import rerun as rr
 
 from harness.recording import entity_names, record_trajectories, recording_path
-from harness.recording_geometry import contact_points, inclinations, quaternion_xyzw
-from harness.recording_loglog import (
+from harness.recording.geometry import contact_points, inclinations, quaternion_xyzw
+from harness.recording.loglog import (
     SingularityTime,
     fit_exponent,
     singularity_time,

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from harness.sweep import exponent_sweep
-from harness.sweep_grid import SweepConfig, initial_state
-from harness.sweep_store import StoreError, SweepStore, load_results
+from harness.sweep.grid import SweepConfig, initial_state
+from harness.sweep.store import StoreError, SweepStore, load_results
 from reference.trajectory import ImpactEvent, Status, Trajectory
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,7 +50,7 @@ def small_config(**kw) -> SweepConfig:
 
 
 def paper_initial_state(seed, i_gamma, i_rho, sample):
-    """The paper's (q0, p0), drawn as the sweep documents it (sweep_grid docstring)."""
+    """The paper's (q0, p0), drawn as the sweep documents it (harness.sweep.grid docstring)."""
     rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(i_gamma, i_rho, sample)))
     x = rng.uniform(-0.5, 0.5, 4)
     return [0.001 * x[2], 0.001 * x[3], 1.0], [0.1 * x[0], 0.1 * x[1], -1.0]
@@ -181,7 +181,7 @@ def test_a_part_without_a_newer_column_reads_with_nulls_there(tmp_path):
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from harness.sweep_store import SCHEMA, read_parts
+    from harness.sweep.store import SCHEMA, read_parts
 
     old = pa.table({"sample": pa.array([4], pa.int32()), "c": [1.25], "status": ["singularity"]})
     pq.write_table(old, tmp_path / "part-old.parquet")
@@ -208,7 +208,7 @@ def _boom_on_sample_1(config, rho, gamma, q0, p0):
 
 
 def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
-    import harness.sweep_run as sr
+    import harness.sweep.run as sr
 
     real = sr.run_linear_sample
     calls = {"n": 0}
@@ -237,7 +237,7 @@ def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
 
 def crash_on_sample_3(chunk):
     """Stand-in for run_chunk whose worker process dies on sample 3."""
-    from harness.sweep_run import run_chunk
+    from harness.sweep.run import run_chunk
 
     if 3 in chunk.samples:
         os._exit(3)
@@ -262,7 +262,7 @@ def test_a_run_that_kills_its_worker_is_recorded_and_the_others_survive(tmp_path
 
 SLOW_CLI = """
 import sys, time
-import harness.sweep_run as sr
+import harness.sweep.run as sr
 real = sr.run_linear_sample
 def slow(*a, **k):
     time.sleep(0.04)
@@ -402,7 +402,7 @@ def test_trajectory_exponent_recovers_a_power_law_beyond_the_clock_resolution(c)
     """100 impacts down to 0.5^99 ≈ 1.6e-30 before t_f = 4: the intervals below the
     double-double clock's resolution (~1e-28 t) are left out, and t_f − t_K (below an
     ulp of t_f) is extrapolated, not taken from t_singularity."""
-    from harness.sweep_run import trajectory_exponent
+    from harness.sweep.run import trajectory_exponent
 
     fit = trajectory_exponent(_power_law_trajectory(c, 1.7, 4.0), min_decades=4)
     assert fit["c"] == pytest.approx(c, rel=1e-9)
@@ -412,7 +412,7 @@ def test_trajectory_exponent_recovers_a_power_law_beyond_the_clock_resolution(c)
 
 @pytest.mark.parametrize("c", [2.0, 3.1])
 def test_trajectory_exponent_uses_a_resolved_t_singularity(c):
-    from harness.sweep_run import trajectory_exponent
+    from harness.sweep.run import trajectory_exponent
 
     fit = trajectory_exponent(_power_law_trajectory(c, 1.7, 4.0, k=30))
     assert fit["remainder_from"] == "t_singularity" and fit["n_used"] == 30
@@ -420,14 +420,14 @@ def test_trajectory_exponent_uses_a_resolved_t_singularity(c):
 
 
 def test_trajectory_exponent_needs_enough_decades():
-    from harness.sweep_run import trajectory_exponent
+    from harness.sweep.run import trajectory_exponent
 
     fit = trajectory_exponent(_power_law_trajectory(0.4, 1.0, 4.0))  # window 5.96 decades
     assert fit["c"] is None and 5.5 < fit["fit_decades"] < 6
 
 
 def test_trajectory_exponent_without_t_singularity_uses_the_last_impact():
-    from harness.sweep_run import trajectory_exponent
+    from harness.sweep.run import trajectory_exponent
 
     # t_f taken at the last used impact: time-to-go 0.5^i − 0.5^K, still E ∝ ttg^c to
     # within the window (the last decades are left out)
@@ -441,7 +441,7 @@ def test_trajectory_exponent_on_excess_energy_matches_the_linear_model():
     invariants) against the linear model's own estimator, same initial state, where
     gravity keeps the motion self-similar (c = 2, paper section 3.4)."""
     from harness.simulators import run_simulator
-    from harness.sweep_run import excess_energy_at, polygon_scene, trajectory_exponent
+    from harness.sweep.run import excess_energy_at, polygon_scene, trajectory_exponent
     from reference.linear.simulate import run_linear_exponent
 
     cfg = small_config(engine="reference")

@@ -35,7 +35,7 @@ import rerun.blueprint as rrb
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
-from .recording_geometry import (
+from .geometry import (
     bump_positions,
     contact_points,
     ground_square,
@@ -44,7 +44,7 @@ from .recording_geometry import (
     polygon_outline,
     quaternion_xyzw,
 )
-from .recording_loglog import (
+from .loglog import (
     ExponentFit,
     SingularityTime,
     fit_exponent,

@@ -29,7 +29,7 @@ class SweepConfig:
     `t_end` and `min_decades` apply to Trajectory engines; the linear model runs to
     the singularity and uses its own estimator (reference.linear.exponent).  `t_end`
     is a cap: the linear model's t_f reaches ~91 at γ = 0.95 from the paper's initial
-    states, and fixed-step engines run to 1.5 t_lin + 0.5 (sweep_run.fixed_step_t_end).
+    states, and fixed-step engines run to 1.5 t_lin + 0.5 (run.fixed_step_t_end).
     `dt` to fixed-step engines only."""
 
     n: int

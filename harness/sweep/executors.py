@@ -1,9 +1,9 @@
 """Executors for sweep chunks: a local process pool (default) or a Dask cluster.
 
-Both run `harness.sweep_run.run_chunk` on plain-data chunks and yield (chunk, rows) as
+Both run `harness.sweep.run.run_chunk` on plain-data chunks and yield (chunk, rows) as
 chunks finish, in completion order, with at most a few chunks per worker in flight so
 that memory stays flat and an interrupt stops quickly.  Results do not depend on the
-executor: every task's initial state comes from its own seed (sweep_grid).
+executor: every task's initial state comes from its own seed (harness.sweep.grid).
 
 Failures: a run that raises is caught inside the chunk (a `failed` row with its error).
 A chunk that fails as a whole (a worker process died, e.g. a segfault in an engine) is
@@ -21,8 +21,8 @@ import time
 from collections import deque
 from collections.abc import Iterator
 
-from .sweep_grid import Chunk
-from .sweep_run import failed_rows, run_chunk
+from .grid import Chunk
+from .run import failed_rows, run_chunk
 
 MAX_ATTEMPTS = 2
 

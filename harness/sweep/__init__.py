@@ -1,9 +1,9 @@
 """`harness sweep exponent`: the energy-exponent map over (γ, ρ) (paper section 4.3).
 
-For every grid point and sample: the paper's random initial state (sweep_grid), a run of
-the chosen simulator and its exponent c (sweep_run), persisted at once as a Parquet part
-(sweep_store), on a local process pool or a Dask cluster (sweep_exec); then the map, the
-simultaneous-impact fraction and the sections as PNGs (sweep_plots).
+For every grid point and sample: the paper's random initial state (grid), a run of
+the chosen simulator and its exponent c (run), persisted at once as a Parquet part
+(store), on a local process pool or a Dask cluster (executors); then the map, the
+simultaneous-impact fraction and the sections as PNGs (plots).
 
 Directory layout (design): --out is a study directory holding one subdirectory per
 simulator, ROOT/<engine>/ with its manifest, parts and PNGs.  Running the same command
@@ -24,16 +24,16 @@ from pathlib import Path
 
 from reference.scene import SceneError
 
-from .simulators import ENGINES, FIXED_STEP
-from .sweep_exec import ExecutorError
-from .sweep_grid import (
+from ..simulators import ENGINES, FIXED_STEP
+from .executors import ExecutorError
+from .grid import (
     SweepConfig,
     all_keys,
     default_chunk_size,
     default_min_decades,
     make_chunks,
 )
-from .sweep_store import KEY, StoreError, SweepStore, engines_in, load_results
+from .store import KEY, StoreError, SweepStore, engines_in, load_results
 
 
 class SweepError(SceneError):
@@ -119,11 +119,11 @@ def exponent_sweep(
 ) -> dict:
     """Run (or resume) a sweep into the study directory `out` and summarise it.
 
-    `run_fn` replaces sweep_run.run_chunk (tests); `figures=False` skips the PNGs."""
+    `run_fn` replaces run.run_chunk (tests); `figures=False` skips the PNGs."""
     from tqdm import tqdm
 
-    from . import sweep_exec
-    from .sweep_run import run_chunk
+    from . import executors as sweep_exec
+    from .run import run_chunk
 
     run_fn = run_fn or run_chunk
     say = progress or (lambda msg: None)
@@ -148,7 +148,7 @@ def exponent_sweep(
             results = sweep_exec.run_dask(chunks, scheduler, fn=run_fn)
         else:
             if missing and run_fn is run_chunk:
-                from .sweep_run import warm_up
+                from .run import warm_up
 
                 warm_up(config)
             results = sweep_exec.run_local(chunks, workers=workers, fn=run_fn)
@@ -183,7 +183,7 @@ def exponent_sweep(
     figs: dict = {}
     t_fig = time.perf_counter()
     if figures and len(df):
-        from .sweep_plots import make_sweep_figures
+        from .plots import make_sweep_figures
 
         say("sweep: drawing figures")
         figs = make_sweep_figures(store.dir, df, config)
@@ -207,7 +207,7 @@ def exponent_sweep(
 
 def _comparisons(root: Path, config: SweepConfig) -> dict:
     """compare-<engine>-vs-<base>.png for the engines stored beside this one."""
-    from .sweep_plots import make_compare_figure
+    from .plots import make_compare_figure
 
     found = {e: c for e, c in engines_in(root).items() if c.n == config.n}
     base = "linear" if "linear" in found else ("reference" if "reference" in found else None)
@@ -234,7 +234,7 @@ def _f(x):
 
 def summarise(config, df, store, statuses_now, n_before, n_missing, duplicates) -> dict:
     """The JSON document: grid, counts by status, mean c per grid point, where things are."""
-    from .sweep_stats import STATUSES, grid_stats
+    from .stats import STATUSES, grid_stats
 
     stats = grid_stats(df, config)
     counts = {s: int((df["status"] == s).sum()) for s in STATUSES} if len(df) else {}

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .sweep_grid import SweepConfig
-from .sweep_stats import (
+from .grid import SweepConfig
+from .stats import (
     as_grid,
     boundary_grid,
     c_lin_curve,

@@ -19,15 +19,15 @@ import numpy as np
 from reference.scene import Scene, SceneError
 from reference.trajectory import Status, Trajectory
 
-from .metrics import (
+from ..metrics import (
     RELATIVE_TIME_TOLERANCE,
     STEPS_TIME_TOLERANCE,
     RunMetrics,
     effective_restitution,
     evaluate,
 )
-from .report import table
-from .simulators import DEFAULT_DT, FIXED_STEP, run_simulator
+from ..text import table
+from ..simulators import DEFAULT_DT, FIXED_STEP, run_simulator
 
 
 @dataclass

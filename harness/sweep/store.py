@@ -26,7 +26,7 @@ import pyarrow as pa
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
-from .sweep_grid import SweepConfig
+from .grid import SweepConfig
 
 KEY = ("i_restitution", "i_gyration", "sample")
 

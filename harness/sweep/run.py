@@ -20,7 +20,7 @@ import traceback
 
 import numpy as np
 
-from .sweep_grid import Chunk, SweepConfig, initial_state
+from .grid import Chunk, SweepConfig, initial_state
 
 LOG10 = math.log(10.0)
 
@@ -236,7 +236,7 @@ def fixed_step_t_end(config: SweepConfig, rho: float, gamma: float, q0, p0) -> f
 
 
 def run_trajectory_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) -> dict:
-    from .simulators import FIXED_STEP, run_simulator
+    from ..simulators import FIXED_STEP, run_simulator
 
     t_end = config.t_end
     if config.engine in FIXED_STEP:

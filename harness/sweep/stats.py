@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .sweep_grid import SweepConfig
+from .grid import SweepConfig
 
 STATUSES = ("singularity", "simultaneous_impact", "t_end", "max_impacts", "failed")
 

@@ -52,16 +52,16 @@ from reference.scene import Body, Ground, InitialState, RunSettings, Scene, Scen
 from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
-from .metrics import (
+from ..metrics import (
     chatter_tail,
     common_window,
     impact_windows,
     match_impacts,
     match_tolerance,
 )
-from .report import table
-from .scenes import resolve_scene
-from .simulators import DEFAULT_DT, ENGINES, FIXED_STEP, check_engine, run_simulator
+from ..text import table
+from ..scenes import resolve_scene
+from ..simulators import DEFAULT_DT, ENGINES, FIXED_STEP, check_engine, run_simulator
 
 DEFAULT_BUDGET_S = 30.0  # per run
 # Verdict thresholds.  Energy gain relative to |E0|; penetration relative to L.
