@@ -183,8 +183,8 @@ def _load(args):
 
 
 def cmd_simulate(args) -> int:
-    from .text import format_simulate
     from .simulators import check_engine, run_simulator
+    from .text import format_simulate
 
     check_engine(args.engine)
     scene = _load(args)

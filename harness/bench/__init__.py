@@ -41,8 +41,8 @@ from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
 from ..metrics import evaluate
-from ..text import table
 from ..simulators import ENGINES, FIXED_STEP, check_engine, run_simulator
+from ..text import table
 
 DEFAULT_DTS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6)
 # (contact_rtol, chatter_tol), loose to tight; the last one is the truth.

@@ -26,8 +26,8 @@ from ..metrics import (
     effective_restitution,
     evaluate,
 )
-from ..text import table
 from ..simulators import DEFAULT_DT, FIXED_STEP, run_simulator
+from ..text import table
 
 
 @dataclass

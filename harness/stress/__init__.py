@@ -59,9 +59,9 @@ from ..metrics import (
     match_impacts,
     match_tolerance,
 )
-from ..text import table
 from ..scenes import resolve_scene
 from ..simulators import DEFAULT_DT, ENGINES, FIXED_STEP, check_engine, run_simulator
+from ..text import table
 
 DEFAULT_BUDGET_S = 30.0  # per run
 # Verdict thresholds.  Energy gain relative to |E0|; penetration relative to L.
