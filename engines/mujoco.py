@@ -37,11 +37,12 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
+from reference import quaternion as qt
 from reference.body import BodyModel, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
-from .base import build_trajectory
+from .base import build_trajectory, contact_kinematics
 from .mujoco_model import FACE_HALF_THICKNESS_FRACTION, contact_settings, load_model
 
 ENGINE_NAMES = {"tuned": "mujoco", "default": "mujoco-default"}
@@ -54,29 +55,20 @@ FALL_THROUGH_DEPTH = FACE_HALF_THICKNESS_FRACTION
 
 
 # --------------------------------------------------------------------------- states
-def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """R(q) v for quaternions (..., 4) wxyz and vectors (..., 3):
-    v + 2w (u × v) + 2 u × (u × v), u the vector part."""
-    w = q[..., :1]
-    u = q[..., 1:]
-    uv = np.cross(u, v)
-    return v + 2.0 * w * uv + 2.0 * np.cross(u, uv)
-
-
 def to_mujoco_state(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reference state [x, q wxyz, v, ω world] (13) → MuJoCo (qpos (7), qvel (6)) with
     qvel's angular part in the body frame: ω_body = R(q)ᵀ ω_world."""
     y = np.asarray(y, dtype=float)
     q = y[3:7]
     q_inv = np.array([q[0], -q[1], -q[2], -q[3]])
-    return y[0:7].copy(), np.concatenate([y[7:10], rotate(q_inv, y[10:13])])
+    return y[0:7].copy(), np.concatenate([y[7:10], qt.rotate(q_inv, y[10:13])])
 
 
 def from_mujoco_state(qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
     """MuJoCo (qpos (..., 7), qvel (..., 6)) → reference states (..., 13), ω_world = R ω_body."""
     qpos = np.asarray(qpos, dtype=float)
     qvel = np.asarray(qvel, dtype=float)
-    w_world = rotate(qpos[..., 3:7], qvel[..., 3:6])
+    w_world = qt.rotate(qpos[..., 3:7], qvel[..., 3:6])
     return np.concatenate([qpos, qvel[..., 0:3], w_world], axis=-1)
 
 
@@ -95,46 +87,6 @@ def state_from_kinematics(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndar
     vel = np.zeros(6)
     mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, bid, vel, 0)
     return np.concatenate([data.xpos[bid], data.xquat[bid], vel[3:6], vel[0:3]])
-
-
-# --------------------------------------------------------------------------- geometry
-def contact_kinematics_vectorised(
-    scene: Scene, states: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Gaps and normal velocities (N, k) of states (N, 13): the same geometry as
-    `BodyModel.contacts` (reference/body.py), for all rows at once.
-
-    flat: gap = z + (R p_k)_z, vₙ = v_z + (ω × R p_k)_z.
-    three_point: gap = (x − b_k)·e3, vₙ = v·e3 + (ω × ℓ_k)·e3 with the lever
-    ℓ_k = −(x − b_k) + gap e3, i.e. (ω × ℓ_k)·e3 = −(ω × (x − b_k))·e3."""
-    model = BodyModel.from_scene(scene)
-    x, v, w = states[:, 0:3], states[:, 7:10], states[:, 10:13]
-    qw, qx, qy, qz = states[:, 3:7].T
-    if model.flat:
-        px, py = model.points[:, 0], model.points[:, 1]
-        r0 = np.stack([1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qw * qz)], axis=1)
-        r1 = np.stack([2 * (qx * qy + qw * qz), 1 - 2 * (qx * qx + qz * qz)], axis=1)
-        r2 = np.stack([2 * (qx * qz - qw * qy), 2 * (qy * qz + qw * qx)], axis=1)
-        lx = r0[:, :1] * px + r0[:, 1:] * py
-        ly = r1[:, :1] * px + r1[:, 1:] * py
-        lz = r2[:, :1] * px + r2[:, 1:] * py
-        gap = x[:, 2:3] + lz
-        vn = v[:, 2:3] + w[:, 0:1] * ly - w[:, 1:2] * lx
-        return gap, vn
-    e3 = np.stack(
-        [2 * (qx * qz + qw * qy), 2 * (qy * qz - qw * qx), 1 - 2 * (qx * qx + qy * qy)], axis=1
-    )
-    d = x[:, None, :] - model.points[None, :, :]  # (N, k, 3)
-    gap = np.einsum("nkj,nj->nk", d, e3)
-    vn = np.einsum("nj,nj->n", v, e3)[:, None] - np.einsum(
-        "nkj,nj->nk", np.cross(w[:, None, :], d), e3
-    )
-    return gap, vn
-
-
-def contact_gaps(scene: Scene, states: np.ndarray) -> np.ndarray:
-    """Gaps (N, k) of states (N, 13)."""
-    return contact_kinematics_vectorised(scene, states)[0]
 
 
 # --------------------------------------------------------------------------- running
@@ -215,7 +167,7 @@ def run_mujoco(
         after = st[chunk]
         done += chunk
         state = st[chunk - 1].copy()
-        lowest = contact_gaps(scene, _states(rows[-1], nq, nv)).min(axis=1)
+        lowest = contact_kinematics(scene, _states(rows[-1], nq, nv))[0].min(axis=1)
         if lowest.min() < depth_limit:
             status = Status.FAILED
             bad = int(np.argmax(lowest < depth_limit))

@@ -4,7 +4,7 @@ A pentagon tilted by θ about y (vertex 0 lowest, the next ones ≥ 0.07 a highe
 without spin at speed v0 from a gap h0, so that only vertex 0 touches the ground in the
 first 0.06 s.  The effective restitution is e = −vₙ(after)/vₙ(before) of that vertex,
 with `before` the last sample above the ground and `after` the first sample above it
-again (reference geometry, `engines.mujoco.contact_kinematics_vectorised`).  For soft
+again (reference geometry, `engines.base.contact_kinematics`).  For soft
 contacts that last many steps, gravity acts during the contact and is part of e.
 
     python -m engines.mujoco_restitution      # the table for both profiles
@@ -30,7 +30,8 @@ import numpy as np
 
 from reference.scene import Scene, scene_from_dict
 
-from .mujoco import contact_kinematics_vectorised, simulate_mujoco
+from .base import contact_kinematics
+from .mujoco import simulate_mujoco
 
 GAMMAS = (0.3, 0.5, 0.8, 0.95)
 TIMESTEPS = (1e-3, 1e-4, 1e-5)
@@ -60,7 +61,7 @@ def single_vertex_drop(
 def effective_restitution(scene: Scene, states: np.ndarray, k: int = 0) -> float:
     """−vₙ(after)/vₙ(before) of contact k around its first contact; nan if it never
     touches, 0 if it never leaves."""
-    gap, vn = contact_kinematics_vectorised(scene, states)
+    gap, vn = contact_kinematics(scene, states)
     down = np.flatnonzero(gap[:, k] <= 0.0)
     if not down.size or down[0] == 0:
         return math.nan

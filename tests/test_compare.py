@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from harness import compare as C
-from harness.cli import _finite
+from harness.cli.common import finite
 from harness.scenes import resolve_scene
 from reference.scene import SceneError
 from reference.trajectory import ImpactEvent, Status, Trajectory
@@ -108,7 +108,7 @@ def test_bad_input_still_stops_the_command(monkeypatch):
 
 def test_document_has_the_contract_fields_and_is_strict_json(calls):
     result = C.compare(resolve_scene("pentagon-bounce"), ["linear", "mujoco"], dts=[1e-3])
-    doc = json.loads(json.dumps(_finite(result.to_dict()), allow_nan=False))
+    doc = json.loads(json.dumps(finite(result.to_dict()), allow_nan=False))
     assert doc["scene"] == "pentagon-bounce"
     assert "impacts" not in doc["reference"] and doc["reference"]["status"] == "t_end"
     for row in doc["engines"]:

@@ -9,8 +9,8 @@ import mujoco
 import numpy as np
 import pytest
 
+from engines.base import contact_kinematics
 from engines.mujoco import (
-    contact_kinematics_vectorised,
     from_mujoco_state,
     run_mujoco,
     set_state,
@@ -129,7 +129,7 @@ def test_vectorised_contact_kinematics_match_the_body_model():
         body = BodyModel.from_scene(scene)
         Y = rng.normal(size=(20, 13))
         Y[:, 3:7] /= np.linalg.norm(Y[:, 3:7], axis=1, keepdims=True)
-        gap, vn = contact_kinematics_vectorised(scene, Y)
+        gap, vn = contact_kinematics(scene, Y)
         for y, g, v in zip(Y, gap, vn, strict=True):
             g_ref, _, _, vn_ref, _ = body.contacts(y)
             np.testing.assert_allclose(g, g_ref, atol=1e-14)

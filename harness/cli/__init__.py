@@ -1,0 +1,50 @@
+"""The `harness` command line.
+
+One module per command: `register` adds its parser, `run` executes it.
+
+Exit status: 0 done (also when the physics ends undecidable), 2 bad input (one line on
+stderr), 1 internal failure.  With --json exactly one JSON document goes to stdout;
+progress and logs go to stderr.
+"""
+
+from __future__ import annotations
+
+import sys
+import traceback
+
+from reference.scene import SceneError
+
+from . import analyze, bench, compare, figures, scenes, simulate, stress, sweep
+from .common import BadInput, Parser
+
+COMMANDS = (scenes, simulate, compare, bench, stress, analyze, sweep, figures)
+
+
+def build_parser() -> Parser:
+    p = Parser(prog="harness", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for command in COMMANDS:
+        command.register(sub)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        return args.func(args)
+    except (BadInput, SceneError) as exc:
+        print(f"harness: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("harness: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+    except Exception:
+        traceback.print_exc()
+        print("harness: internal failure (traceback above)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

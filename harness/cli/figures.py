@@ -1,0 +1,22 @@
+"""`harness figures`: the paper's figures as PNGs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .common import emit, log
+
+
+def register(sub) -> None:
+    f = sub.add_parser("figures", help="the paper's figures as PNGs")
+    f.add_argument("--out", default="figures")
+    f.add_argument("--json", action="store_true")
+    f.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..figures import make_figures
+
+    doc = make_figures(Path(args.out), progress=log)
+    emit(doc, args.json, "\n".join(f"{k}: {v}" for k, v in doc.items()))
+    return 0

@@ -1,0 +1,15 @@
+"""`harness scenes`: the built-in scenes, one line each."""
+
+from __future__ import annotations
+
+
+def register(sub) -> None:
+    sub.add_parser("scenes", help="list built-in scenes").set_defaults(func=run)
+
+
+def run(args) -> int:
+    from ..scenes import list_builtin
+
+    for name, desc in list_builtin():
+        print(f"{name:24s} {desc}")
+    return 0
