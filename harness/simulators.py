@@ -63,6 +63,16 @@ _RUNNERS: dict[str, Callable] = {
 }
 
 
+def engine_names() -> list[str]:
+    """Every simulator that can run here, in a stable order (reference first)."""
+    return list(ENGINES)
+
+
+def is_fixed_step(name: str) -> bool:
+    """Whether `--dt` applies to the simulator (fixed-step engines) or not (event-driven)."""
+    return name in FIXED_STEP
+
+
 def check_engine(name: str) -> str:
     if name not in _RUNNERS:
         raise SceneError(f"unknown engine {name!r}; choose from {', '.join(ENGINES)}")

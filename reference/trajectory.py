@@ -123,6 +123,12 @@ class Trajectory:
         )
 
     @property
+    def wall_time_s(self) -> float | None:
+        """Run time of the simulation itself (no one-time compilation or loading)."""
+        w = self.stats.get("wall_time_s")
+        return None if w is None else float(w)
+
+    @property
     def energy(self) -> np.ndarray:
         return self.kinetic_energy + self.potential_energy
 

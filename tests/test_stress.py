@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 
 from harness import stress as S
+from harness.stress import cases as stress_cases
+from harness.stress import judge as stress_judge
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
 from reference.trajectory import ImpactEvent, Status, Trajectory
 
@@ -62,7 +64,7 @@ def level_run(z, energy, impacts=(), status=Status.T_END, dt=1e-3, engine="mujoc
 
 
 def test_length_scale_of_a_level_body_is_its_height():
-    assert S.length_scale(flat_scene()) == pytest.approx(H, rel=1e-15)
+    assert stress_judge.length_scale(flat_scene()) == pytest.approx(H, rel=1e-15)
 
 
 def test_consistent_run_is_ok():
@@ -130,7 +132,7 @@ def test_unmatched_impacts_count_missed_and_spurious_in_any_order():
     ref = level_run([H] * 11, [1.0] * 11, [hit(0.1, 0), hit(0.2, 1), hit(0.3, 0)], dt=None)
     # the run swaps nothing, shifts one hit by 1e-4 s (< 3 dt), misses 0 @ 0.3, adds 2 @ 0.25
     run = level_run([H] * 11, [1.0] * 11, [hit(0.1001, 0), hit(0.2, 1), hit(0.25, 2)])
-    assert S.unmatched_impacts(run, ref, gravity=1.0) == (1, 1, 3)
+    assert stress_judge.unmatched_impacts(run, ref, gravity=1.0) == (1, 1, 3)
     row = S.assess(run, ref, flat_scene(), 1.0)
     assert row["missed_impacts"] == 1 and row["spurious_impacts"] == 1
     assert row["verdict"] == "degraded"
@@ -142,7 +144,7 @@ def test_unmatched_impacts_count_missed_and_spurious_in_any_order():
 def test_alpha_cases_start_at_their_inclination():
     cases = S.select_cases(["alpha"])
     assert [c.name for c in cases] == ["alpha-1e-3", "alpha-1e-6", "alpha-1e-9", "alpha-1e-12"]
-    for case, alpha in zip(cases, S.ALPHAS, strict=True):
+    for case, alpha in zip(cases, stress_cases.ALPHAS, strict=True):
         # linear coordinates: the rotation vector (phi_x, phi_y, 0) has length alpha
         assert math.hypot(*case.scene.initial.rotation_vector) == pytest.approx(alpha, rel=1e-12)
 
