@@ -22,56 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.body import BodyModel
+from reference.geometry import energies
+from reference.geometry import scene_contact_kinematics as contact_kinematics
 from reference.scene import Scene
 from reference.trajectory import ImpactEvent, Status, Trajectory
-
-
-def contact_kinematics(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gap and normal velocity (N, k) of every contact for states (N, 13), vectorised;
-    the same geometry as `BodyModel.contacts` (tests/test_engine_base.py checks it).
-
-    flat: gap = z + (R p_k)_z, vₙ = v_z + (ω × R p_k)_z.
-    three_point: gap = (x − b_k)·e3, vₙ = v·e3 − (ω × (x − b_k))·e3."""
-    model = BodyModel.from_scene(scene)
-    states = np.asarray(states, dtype=float).reshape(-1, 13)
-    x, v, w = states[:, 0:3], states[:, 7:10], states[:, 10:13]
-    qw, qx, qy, qz = states[:, 3:7].T
-    if model.flat:
-        px, py = model.points[:, 0], model.points[:, 1]
-        lx = (1 - 2 * (qy * qy + qz * qz))[:, None] * px + (2 * (qx * qy - qw * qz))[:, None] * py
-        ly = (2 * (qx * qy + qw * qz))[:, None] * px + (1 - 2 * (qx * qx + qz * qz))[:, None] * py
-        lz = (2 * (qx * qz - qw * qy))[:, None] * px + (2 * (qy * qz + qw * qx))[:, None] * py
-        gap = x[:, 2:3] + lz
-        vn = v[:, 2:3] + w[:, 0:1] * ly - w[:, 1:2] * lx
-        return gap, vn
-    e3 = np.stack(
-        [2 * (qx * qz + qw * qy), 2 * (qy * qz - qw * qx), 1 - 2 * (qx * qx + qy * qy)], axis=1
-    )
-    d = x[:, None, :] - model.points[None, :, :]
-    gap = np.einsum("nkj,nj->nk", d, e3)
-    wxd = np.cross(w[:, None, :], d)
-    vn = np.einsum("nj,nj->n", v, e3)[:, None] - np.einsum("nkj,nj->nk", wxd, e3)
-    return gap, vn
-
-
-def energies(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Kinetic and potential energy (N,) of states (N, 13), vectorised (reference formulas:
-    ½ m|v|² + ½ (I1 |ω⊥|² + I3 ω3²), m g z)."""
-    model = BodyModel.from_scene(scene)
-    states = np.asarray(states, dtype=float).reshape(-1, 13)
-    v, w = states[:, 7:10], states[:, 10:13]
-    qw, qx, qy, qz = states[:, 3:7].T
-    e3 = np.stack(
-        [2 * (qx * qz + qw * qy), 2 * (qy * qz - qw * qx), 1 - 2 * (qx * qx + qy * qy)], axis=1
-    )
-    w3 = np.einsum("nj,nj->n", w, e3)
-    wperp2 = np.einsum("nj,nj->n", w, w) - w3 * w3
-    ke = 0.5 * model.mass * np.einsum("nj,nj->n", v, v) + 0.5 * (
-        model.i1 * wperp2 + model.i3 * w3 * w3
-    )
-    pe = model.mass * model.gravity * states[:, 2]
-    return ke, pe
 
 
 def impacts_from_contact_activity(

@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import quaternion as qt
+from .geometry import contact_points
+from .geometry import initial_state as geometry_initial_state
 from .scene import Scene
 
 EPS = np.finfo(float).eps
@@ -55,15 +57,7 @@ class BodyModel:
     @classmethod
     def from_scene(cls, scene: Scene) -> BodyModel:
         i1, _, i3 = scene.body.inertia_diag
-        if scene.ground.kind == "flat":
-            n = scene.body.n
-            ang = 2.0 * np.pi * np.arange(n) / n
-            pts = scene.body.radius * np.stack([np.cos(ang), np.sin(ang), np.zeros(n)], axis=1)
-        else:
-            ang = 2.0 * np.pi * np.arange(3) / 3
-            b = scene.ground.bump_radius
-            pts = b * np.stack([np.cos(ang), np.sin(ang), np.zeros(3)], axis=1)
-        pts.setflags(write=False)
+        pts = contact_points(scene.body, scene.ground)
         return cls(
             mass=scene.body.mass,
             i1=i1,
@@ -224,19 +218,5 @@ class BodyModel:
 
 
 def initial_state(scene: Scene) -> np.ndarray:
-    ini = scene.initial
-    y = np.zeros(13)
-    y[X] = ini.position
-    y[Q] = qt.from_rotation_vector(ini.rotation_vector)
-    y[V] = ini.velocity
-    y[W] = ini.angular_velocity
-    return y
-
-
-def contact_gaps_initial(scene: Scene) -> np.ndarray:
-    model = BodyModel.from_scene(scene)
-    return model.contacts(initial_state(scene))[0]
-
-
-def body_axis_initial(scene: Scene) -> np.ndarray:
-    return qt.body_axis(initial_state(scene)[Q])
+    """The scene's initial 13-component state."""
+    return geometry_initial_state(scene.initial)

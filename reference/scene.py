@@ -16,6 +16,9 @@ from typing import Any
 
 import numpy as np
 
+from .geometry import initial_state, scene_contact_kinematics
+from .quaternion import body_axis
+
 
 class SceneError(ValueError):
     """A scene that cannot be simulated: the message says which field and why."""
@@ -218,20 +221,15 @@ def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
 
 def check_not_below_ground(scene: Scene) -> None:
     """Reject a body that starts with a contact point below the ground."""
-    from .body import contact_gaps_initial  # local import: body depends on scene
-
-    gaps = contact_gaps_initial(scene)
-    scale = scene.body.radius
+    y0 = initial_state(scene.initial)
+    gaps = scene_contact_kinematics(scene, y0)[0][0]
     worst = int(np.argmin(gaps))
-    if gaps[worst] < -1e-12 * scale:
+    if gaps[worst] < -1e-12 * scene.body.radius:
         raise SceneError(
             f"the body starts below the ground: contact {worst} is at gap {gaps[worst]:.3g}"
         )
-    if scene.ground.kind == "three_point":
-        from .body import body_axis_initial
-
-        if body_axis_initial(scene)[2] <= 0.0:
-            raise SceneError("three_point ground needs the body's face normal pointing up")
+    if scene.ground.kind == "three_point" and body_axis(y0[3:7])[2] <= 0.0:
+        raise SceneError("three_point ground needs the body's face normal pointing up")
 
 
 def _table(name: str, data: dict) -> dict:
