@@ -94,3 +94,26 @@ def energies(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ke = 0.5 * scene.body.mass * np.einsum("nj,nj->n", v, v) + 0.5 * (i1 * wperp2 + i3 * w3 * w3)
     pe = scene.body.mass * scene.gravity * states[:, 2]
     return ke, pe
+
+
+def resting_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N,) the lowest energy the invariants allow, the level the motion ends at:
+    flat ground: ½ m |v_h|² + L_z²/(2 I3) (horizontal momentum and the vertical angular
+    momentum are kept by frictionless contacts along e_z; lying flat, L_z = I3 ω_z);
+    three_point: ½ I3 ω3² (the spin about the body axis is kept)."""
+    states = np.asarray(states, dtype=float).reshape(-1, 13)
+    v, w = states[:, 7:10], states[:, 10:13]
+    i1, _, i3 = scene.body.inertia_diag
+    e3 = body_axis(states[:, 3:7])
+    w3 = np.einsum("nj,nj->n", w, e3)
+    if scene.ground.kind == "flat":
+        lz = i1 * w[:, 2] + (i3 - i1) * w3 * e3[:, 2]
+        return 0.5 * scene.body.mass * (v[:, 0] ** 2 + v[:, 1] ** 2) + lz * lz / (2.0 * i3)
+    return 0.5 * i3 * w3 * w3
+
+
+def excess_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N,) energy above `resting_energy`: the E of the paper's E ≈ a (t_f − t)^c, which
+    goes to zero at the end of the motion."""
+    ke, pe = energies(scene, states)
+    return ke + pe - resting_energy(scene, states)
