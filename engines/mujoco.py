@@ -38,7 +38,7 @@ import numpy as np
 from mujoco import rollout
 
 from reference import quaternion as qt
-from reference.body import BodyModel, initial_state
+from reference.geometry import free_acceleration, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
@@ -131,10 +131,9 @@ def run_mujoco(
     settings = contact_settings(scene, dt, profile)
     model = load_model(scene, dt, profile)
     data = mujoco.MjData(model)
-    body = BodyModel.from_scene(scene)
-    y0 = initial_state(scene)
+    y0 = initial_state(scene.initial)
     half = settings.half_step_velocities if half_step is None else half_step
-    set_state(model, data, staggered_start(body, y0, dt) if half else y0)
+    set_state(model, data, staggered_start(scene, y0, dt) if half else y0)
     depth_limit = -FALL_THROUGH_DEPTH * scene.body.radius
     nq, nv = model.nq, model.nv
 
@@ -186,7 +185,7 @@ def run_mujoco(
     impulses = np.clip(F[: len(t)], 0.0, None) * dt
     if half:
         y_after = _states(after[None], nq, nv)[0] if after is not None else None
-        states = whole_step_velocities(body, states, y_after, impulses > 0.0, dt)
+        states = whole_step_velocities(scene, states, y_after, impulses > 0.0, dt)
         states[0, 7:13] = y0[7:13]  # known exactly: MuJoCo started from v(−h/2) built from it
     steps = len(t) - 1
     stats = {
@@ -232,7 +231,7 @@ def simulate_mujoco(
     )
 
 
-def staggered_start(body: BodyModel, y0: np.ndarray, dt: float) -> np.ndarray:
+def staggered_start(scene: Scene, y0: np.ndarray, dt: float) -> np.ndarray:
     """Initial MuJoCo state for the leapfrog reading: velocities at t = −h/2,
     [v; ω](−h/2) = [v; ω](0) − (h/2)·[v̇; ω̇]_free(y0) (gravity and gyroscopic term).
 
@@ -242,12 +241,12 @@ def staggered_start(body: BodyModel, y0: np.ndarray, dt: float) -> np.ndarray:
     under gravity makes every flight's height low by g h t/2 and its impacts early by
     ~g h t/(2|vₙ|) (first order in h)."""
     y = np.array(y0, dtype=float)
-    y[7:13] -= 0.5 * dt * body.free_acceleration(y0)
+    y[7:13] -= 0.5 * dt * free_acceleration(scene, y0)[0]
     return y
 
 
 def whole_step_velocities(
-    body: BodyModel,
+    scene: Scene,
     states: np.ndarray,
     after: np.ndarray | None,
     active: np.ndarray,
@@ -268,14 +267,14 @@ def whole_step_velocities(
     if after is not None:
         nxt[-1] = after[7:13]
     else:
-        nxt[-1] = states[-1, 7:13] + dt * body.free_acceleration(states[-1])[:6]
+        nxt[-1] = states[-1, 7:13] + dt * free_acceleration(scene, states[-1])[0]
     out[:, 7:13] = 0.5 * (states[:, 7:13] + nxt)
     onset = active.any(axis=1)
     onset[1:] &= (active[1:] & ~active[:-1]).any(axis=1)
     for j in np.flatnonzero(onset):
         y = states[j].copy()
         y[7:13] = nxt[j]
-        out[j, 7:13] = nxt[j] - 0.5 * dt * body.free_acceleration(y)
+        out[j, 7:13] = nxt[j] - 0.5 * dt * free_acceleration(scene, y)[0]
     return out
 
 

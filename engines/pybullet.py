@@ -61,7 +61,7 @@ import pybullet as pb
 
 from engines.base import build_trajectory
 from reference import quaternion as qt
-from reference.body import BodyModel, initial_state
+from reference.geometry import energies, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
@@ -205,9 +205,9 @@ def _breaking_threshold(scene: Scene, dt: float) -> float:
     With kinetic energy K ≤ E(0) (γ ≤ 1, potential ≥ 0 above the ground),
     |v + ω × r| ≤ |v| + a|ω| ≤ √(2E/m) + a √(2E/I₁) = √(2E/m) (1 + 1/ρ); g dt is added
     for a body starting at rest."""
-    model = BodyModel.from_scene(scene)
-    energy = max(model.energy(initial_state(scene)), 0.0)
-    v_bound = math.sqrt(2.0 * energy / model.mass) * (1.0 + 1.0 / scene.body.gyration)
+    ke, pe = energies(scene, initial_state(scene.initial))
+    energy = max(float(ke[0] + pe[0]), 0.0)
+    v_bound = math.sqrt(2.0 * energy / scene.body.mass) * (1.0 + 1.0 / scene.body.gyration)
     v_bound += scene.gravity * dt
     return max(8.0 * v_bound * dt, 16.0 * scene.gravity * dt * dt)
 
@@ -260,7 +260,7 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
     pb.setGravity(0.0, 0.0, -g, **cid)
     pb.setPhysicsEngineParameter(**_engine_parameters(scene, dt, profile), **cid)
 
-    y0 = initial_state(scene)
+    y0 = initial_state(scene.initial)
     x0, q0 = y0[0:3], y0[3:7]
     with tempfile.TemporaryDirectory(prefix="pybullet-scene-") as tmp:
         body = pb.loadURDF(
@@ -338,7 +338,7 @@ def read_state(h: Handles) -> np.ndarray:
 
 def _contact_index_flat(points: np.ndarray, x: np.ndarray, q: np.ndarray, n: int) -> np.ndarray:
     """Vertex k whose body-frame angle 2πk/n is nearest to each world point on the body."""
-    d = (points - x) @ qt.to_matrix(q)  # rows: Rᵀ (p − x)
+    d = qt.rotate(qt.conjugate(q), points - x)  # rows: Rᵀ (p − x)
     ang = np.arctan2(d[:, 1], d[:, 0])
     return np.rint(ang * n / (2.0 * math.pi)).astype(int) % n
 

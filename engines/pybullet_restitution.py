@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from reference.body import BodyModel
+from reference.geometry import scene_contact_kinematics
 from reference.scene import Scene, scene_from_dict
 
 
@@ -71,8 +71,7 @@ def _first_impact(gamma, dt, profile, **scene_options) -> tuple[float, float, fl
     # onset row: the first sample after the impact time (its predecessor is the step
     # before, both are kept by simulate_pybullet around contact activity)
     j = int(np.searchsorted(traj.t, first.t, side="right"))
-    model = BodyModel.from_scene(scene)
-    vn = [model.contacts(_state(traj, i))[3][0] for i in (j - 1, j)]
+    vn = [scene_contact_kinematics(scene, _state(traj, i))[1][0, 0] for i in (j - 1, j)]
     return -first.v_normal_post / first.v_normal_pre, -vn[1] / vn[0], first.t
 
 

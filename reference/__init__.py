@@ -1,8 +1,27 @@
 """Exact reference model of a thin polygonal disk with frictionless unilateral point
-contacts and Newtonian impacts (Baranyai & Várkonyi), plus the paper's linearised model
-in `reference.linear`.  Pure numerics: no I/O, no CLI."""
+contacts and Newtonian impacts (Baranyai & Várkonyi, "Imperfections, impacts, and the
+singularity of Euler's disk"), plus the paper's linearised model in `reference.linear`.
+Pure numerics: no I/O beyond reading scene files, no CLI.
 
-from .scene import Body, Ground, InitialState, RunSettings, Scene, SceneError, load_scene
+The public API (kept stable; docs/api.md):
+
+    from reference import Scene, load_scene, simulate, Trajectory
+    from reference.linear import simulate_linear
+"""
+
+from .options import ReferenceOptions
+from .scene import (
+    Body,
+    Ground,
+    InitialState,
+    RunSettings,
+    Scene,
+    SceneError,
+    load_scene,
+    scene_from_dict,
+)
+from .simulate import simulate
+from .stats import RunStats
 from .trajectory import ImpactEvent, Phase, Status, Trajectory
 
 __all__ = [
@@ -11,10 +30,14 @@ __all__ = [
     "ImpactEvent",
     "InitialState",
     "Phase",
+    "ReferenceOptions",
     "RunSettings",
+    "RunStats",
     "Scene",
     "SceneError",
     "Status",
     "Trajectory",
     "load_scene",
+    "scene_from_dict",
+    "simulate",
 ]

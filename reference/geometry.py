@@ -13,8 +13,8 @@ Contacts (the model of Baranyai & Várkonyi, section 2):
   body's face (the plane through the centre of mass with normal e3 = R ẑ) touches it:
   gap (x − b_k)·e3, normal velocity v·e3 − (ω × (x − b_k))·e3.
 
-The compiled event loop evaluates the same contacts one at a time in
-`reference.core.contacts`; tests check the two against each other.
+The formulas are the compiled core's (reference.core.contacts, reference.core.inertia),
+applied row by row (reference.core.arrays).
 """
 
 from __future__ import annotations
@@ -23,7 +23,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .quaternion import body_axis, from_rotation_vector
+from .compiled import function
+from .quaternion import from_rotation_vector
 
 if TYPE_CHECKING:  # geometry depends on no other module of the package
     from .scene import Body, Ground, InitialState, Scene
@@ -52,26 +53,18 @@ def initial_state(initial: InitialState) -> np.ndarray:
     return y
 
 
+def _states(states: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(states, dtype=float).reshape(-1, 13))
+
+
 def contact_kinematics(
     states: np.ndarray, points: np.ndarray, flat: bool
 ) -> tuple[np.ndarray, np.ndarray]:
     """Gap and normal velocity (N, k) of every contact for states (N, 13)."""
-    states = np.asarray(states, dtype=float).reshape(-1, 13)
-    x, v, w = states[:, 0:3], states[:, 7:10], states[:, 10:13]
-    if flat:
-        qw, qx, qy, qz = states[:, 3:7].T
-        px, py = points[:, 0], points[:, 1]
-        lx = (1 - 2 * (qy * qy + qz * qz))[:, None] * px + (2 * (qx * qy - qw * qz))[:, None] * py
-        ly = (2 * (qx * qy + qw * qz))[:, None] * px + (1 - 2 * (qx * qx + qz * qz))[:, None] * py
-        lz = (2 * (qx * qz - qw * qy))[:, None] * px + (2 * (qy * qz + qw * qx))[:, None] * py
-        gap = x[:, 2:3] + lz
-        vn = v[:, 2:3] + w[:, 0:1] * ly - w[:, 1:2] * lx
-        return gap, vn
-    e3 = body_axis(states[:, 3:7])
-    d = x[:, None, :] - points[None, :, :]
-    gap = np.einsum("nkj,nj->nk", d, e3)
-    wxd = np.cross(w[:, None, :], d)
-    vn = np.einsum("nj,nj->n", v, e3)[:, None] - np.einsum("nkj,nj->nk", wxd, e3)
+    S = _states(states)
+    pts = np.ascontiguousarray(points, dtype=float)
+    gap, vn = np.empty((len(S), len(pts))), np.empty((len(S), len(pts)))
+    function("contact_kinematics_rows")(S, pts, bool(flat), gap, vn)
     return gap, vn
 
 
@@ -82,38 +75,48 @@ def scene_contact_kinematics(scene: Scene, states: np.ndarray) -> tuple[np.ndarr
     )
 
 
+def _energy_rows(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N, 3): kinetic, potential and excess energy of each state."""
+    S = _states(states)
+    i1, _, i3 = scene.body.inertia_diag
+    out = np.empty((len(S), 3))
+    flat = scene.ground.kind == "flat"
+    function("energy_rows")(S, flat, scene.body.mass, i1, i3, scene.gravity, out)
+    return out
+
+
 def energies(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Kinetic and potential energy (N,) of states (N, 13):
     ½ m|v|² + ½ (I1 |ω⊥|² + I3 ω3²) and m g z."""
-    states = np.asarray(states, dtype=float).reshape(-1, 13)
-    v, w = states[:, 7:10], states[:, 10:13]
-    i1, _, i3 = scene.body.inertia_diag
-    e3 = body_axis(states[:, 3:7])
-    w3 = np.einsum("nj,nj->n", w, e3)
-    wperp2 = np.einsum("nj,nj->n", w, w) - w3 * w3
-    ke = 0.5 * scene.body.mass * np.einsum("nj,nj->n", v, v) + 0.5 * (i1 * wperp2 + i3 * w3 * w3)
-    pe = scene.body.mass * scene.gravity * states[:, 2]
-    return ke, pe
-
-
-def resting_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
-    """(N,) the lowest energy the invariants allow, the level the motion ends at:
-    flat ground: ½ m |v_h|² + L_z²/(2 I3) (horizontal momentum and the vertical angular
-    momentum are kept by frictionless contacts along e_z; lying flat, L_z = I3 ω_z);
-    three_point: ½ I3 ω3² (the spin about the body axis is kept)."""
-    states = np.asarray(states, dtype=float).reshape(-1, 13)
-    v, w = states[:, 7:10], states[:, 10:13]
-    i1, _, i3 = scene.body.inertia_diag
-    e3 = body_axis(states[:, 3:7])
-    w3 = np.einsum("nj,nj->n", w, e3)
-    if scene.ground.kind == "flat":
-        lz = i1 * w[:, 2] + (i3 - i1) * w3 * e3[:, 2]
-        return 0.5 * scene.body.mass * (v[:, 0] ** 2 + v[:, 1] ** 2) + lz * lz / (2.0 * i3)
-    return 0.5 * i3 * w3 * w3
+    e = _energy_rows(scene, states)
+    return e[:, 0], e[:, 1]
 
 
 def excess_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
-    """(N,) energy above `resting_energy`: the E of the paper's E ≈ a (t_f − t)^c, which
-    goes to zero at the end of the motion."""
-    ke, pe = energies(scene, states)
-    return ke + pe - resting_energy(scene, states)
+    """(N,) energy above the lowest level the invariants allow (the level the motion ends
+    at: flat ground E − ½ m |v_h|² − L_z²/(2 I3), three-point E − ½ I3 ω3²): the E of
+    the paper's E ≈ a (t_f − t)^c, which goes to zero at the end of the motion."""
+    return _energy_rows(scene, states)[:, 2]
+
+
+def resting_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N,) the lowest energy the invariants allow (see `excess_energy`)."""
+    e = _energy_rows(scene, states)
+    return e[:, 0] + e[:, 1] - e[:, 2]
+
+
+def free_acceleration(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N, 6): (v̇, ω̇) without contact forces: (0, 0, −g) and −I⁻¹(ω × Iω)."""
+    S = _states(states)
+    i1, _, i3 = scene.body.inertia_diag
+    out = np.empty((len(S), 6))
+    function("free_acceleration_rows")(S, i1, i3, scene.gravity, out)
+    return out
+
+
+def length_scale(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N,) the local length unit |z| + a sin α of each state."""
+    S = _states(states)
+    out = np.empty(len(S))
+    function("length_scale_rows")(S, scene.body.radius, out)
+    return out

@@ -1,637 +1,279 @@
-"""The exact reference: event-driven simulation of the full Newton–Euler model.
+"""`simulate`: the exact reference on a scene, returned as a `Trajectory`.
 
-Phases alternate between closed-form free flight (`flight`), sustained contact with one
-or two points (`contact`), and instantaneous events: single-point Newtonian impacts
-(`impact`), lift-off (a contact force reaching zero), chatter completion and the end of
-the motion.  The run stops with an explicit `Status` and never guesses:
-
-- two contacts reached within the time resolution, or an impact that would drive a
-  resting contact into the ground (the paper's rule), end the run with
-  `simultaneous_impact`, naming the contacts and the time;
-- all contacts down, or the energy above the resting level exhausted down to
-  `energy_floor` of its initial value, end it with `singularity` and `t_singularity`
-  (extrapolated from the geometric sequence of the last impact intervals).
-
-Time is kept as a double-double (t_hi + t_lo) and every phase is computed in its own
-local time, so that intervals near the singularity keep all their digits.
-
-Chatter (0 < γ < 1, DESIGN.md §2): after an impact whose post-impact normal velocity u
-is below `chatter_tol` times the body's velocity scale V while the contact point falls
-back (normal acceleration a_n < 0), the remaining infinite sequence of impacts is
-completed: u is removed by a normal impulse and the contact is held.  The exact sequence
-accumulates at t + 2u / (|a_n| (1 − γ)) and delivers, to leading order, the same total
-impulse as the completion (−m u + 2 m u / (1 − γ) = m u (1 + γ) / (1 − γ) per unit
-effective mass), only spread over that window, so the completion changes the state at
-the accumulation time by O((u / V)²) relative: (chatter_tol)² = 1e-12 for the default
-1e-6.  Bounces lower than the gap's roundoff band (u < 4 √(2 |a_n| ε z)) cannot be
-resolved one by one at all; completion always takes over there.
-tests/test_reference_chatter.py measures it against a run that resolves the impacts one
-by one down to that floor.
+This module sets the problem up for the compiled event loop (reference.core.loop: the
+model, options and state as records), calls it until the run ends, growing the output
+arrays when it asks and reporting progress between calls, and turns what it wrote into
+a Trajectory with a status, a message and typed `RunStats`.  The physics is all in
+reference.core.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
-from . import events as events_mod
-from . import quaternion as qt
-from .body import BodyModel, Q, V, W, initial_state
-from .contact import (
-    chunk_horizon,
-    constrained_acceleration,
-    contact_forces,
-    integrate_chunk,
-    project_velocities,
-    solve_contact_lcp,
+from . import compiled
+from .core import records as R
+from .core.records import (
+    N_ACCUMULATIONS,
+    N_IMPACTS,
+    N_PHASES,
+    N_SAMPLES,
+    RETURN_DONE,
+    RETURN_GROW,
 )
-from .events import gap_jet, next_flight_event
-from .flight import flight_constants, free_flight
-from .impact import apply_normal_impulses, impact_impulse
+from .geometry import contact_points, initial_state
+from .options import ReferenceOptions
 from .scene import Scene
-from .trajectory import ImpactEvent, ImpactLog, Phase, SampleBuffer, Status, Trajectory
+from .stats import RunStats
+from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
 
-# compiled contact phases over flat ground (reference.contact_kernel); the Python loop
-# below stays the specification and handles every event
-USE_CONTACT_KERNEL = True
-
-
-@dataclass(frozen=True)
-class ReferenceOptions:
-    sample_dt: float | None = None  # flight/contact sample spacing; default t_end / 2000
-    chatter_tol: float = 1e-6  # complete chatter when u ≤ chatter_tol · V
-    contact_rtol: float = 1e-12  # DOP853 tolerance in contact phases
-    energy_floor: float = 1e-18  # singularity when excess energy ≤ floor · initial excess
-    max_samples: int = 500_000
-
-
-class _Clock:
-    """Double-double time: hi + lo with |lo| ≤ ulp(hi)/2 (Knuth's two-sum)."""
-
-    def __init__(self) -> None:
-        self.hi, self.lo = 0.0, 0.0
-
-    def add(self, s: float) -> None:
-        hi = self.hi + s
-        bb = hi - self.hi
-        err = (self.hi - (hi - bb)) + (s - bb)
-        lo = self.lo + err
-        self.hi = hi + lo
-        self.lo = lo - (self.hi - hi)
-
-    def minus(self, other_hi: float, other_lo: float = 0.0) -> float:
-        """self − other as a float, exact to the last bit of the difference."""
-        return (self.hi - other_hi) + (self.lo - other_lo)
+# initial rows of the output arrays (they grow by doubling when the loop asks)
+INITIAL_ROWS = {"samples": 4096, "impacts": 1024, "phases": 1024, "accumulations": 64}
 
 
 @dataclass
-class _Run:
-    model: BodyModel
-    gamma: float
-    t_end: float
-    opts: ReferenceOptions
-    clock: _Clock = field(default_factory=_Clock)
-    buf: SampleBuffer = field(default_factory=SampleBuffer)
-    impacts: ImpactLog = field(default_factory=ImpactLog)
-    phases: list[Phase] = field(default_factory=list)
-    stats: dict = field(default_factory=dict)
-    max_impacts: int = 100_000
+class Problem:
+    """The records and arrays one run of the loop reads and writes."""
 
-    def sample(self, y: np.ndarray, s: float = 0.0) -> None:
-        """Record state y at local time s after the clock."""
-        if len(self.buf) >= self.opts.max_samples:
+    model: np.ndarray  # records.MODEL, 1 element
+    points: np.ndarray  # (k, 3) contact points
+    options: np.ndarray  # records.OPTIONS
+    state: np.ndarray  # records.STATE
+    counters: np.ndarray  # records.STATS
+    sample_t: np.ndarray
+    sample_y: np.ndarray
+    sample_e: np.ndarray
+    impacts: np.ndarray
+    phases: np.ndarray
+    accumulations: np.ndarray
+    counts: np.ndarray
+
+    def arguments(self) -> tuple:
+        return (
+            self.model, self.points, self.options, self.state, self.counters,
+            self.sample_t, self.sample_y, self.sample_e, self.impacts, self.phases,
+            self.accumulations, self.counts,
+        )  # fmt: skip
+
+    def grow(self, max_samples: int) -> None:
+        """Double every output array that is nearly full (samples: double, up to
+        max_samples rows)."""
+        c = self.counts
+        for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES)):
+            arr = getattr(self, name)
+            if len(arr) - c[col] < 8:
+                setattr(self, name, _grown(arr, 2 * len(arr)))
+        if len(self.accumulations) - c[N_ACCUMULATIONS] < 8:
+            self.accumulations = _grown(self.accumulations, 2 * len(self.accumulations))
+        rows = min(2 * len(self.sample_t), max(max_samples, 1))
+        if rows > len(self.sample_t):
+            self.sample_t = _grown(self.sample_t, rows)
+            self.sample_y = _grown(self.sample_y, rows)
+            self.sample_e = _grown(self.sample_e, rows)
+
+
+def _grown(arr: np.ndarray, rows: int) -> np.ndarray:
+    new = np.zeros((rows, *arr.shape[1:]), dtype=arr.dtype)
+    new[: len(arr)] = arr
+    return new
+
+
+def model_record(scene: Scene) -> np.ndarray:
+    """The body, ground and impact law as the core reads them."""
+    i1, _, i3 = scene.body.inertia_diag
+    flat = scene.ground.kind == "flat"
+    rec = np.zeros(1, dtype=R.MODEL)
+    rec["mass"], rec["i1"], rec["i3"] = scene.body.mass, i1, i3
+    rec["radius"], rec["gravity"], rec["gamma"] = (
+        scene.body.radius,
+        scene.gravity,
+        scene.restitution,
+    )
+    rec["flat_ground"] = flat
+    rec["n_contacts"] = scene.n_contacts
+    rec["all_down"] = 2 if flat and scene.body.n == 2 else 3
+    return rec
+
+
+def options_record(scene: Scene, t_end: float, opts: ReferenceOptions) -> np.ndarray:
+    rec = np.zeros(1, dtype=R.OPTIONS)
+    rec["t_end"] = t_end
+    rec["sample_dt"] = opts.sample_dt or t_end / 2000.0
+    rec["chatter_tol"] = opts.chatter_tol
+    rec["contact_rtol"] = opts.contact_rtol
+    rec["energy_floor"] = opts.energy_floor
+    rec["max_samples"] = opts.max_samples
+    rec["max_impacts"] = scene.run.max_impacts
+    rec["window_search"] = opts.window_search
+    rec["work_budget"] = opts.work_budget
+    return rec
+
+
+def initial_record(y0: np.ndarray) -> np.ndarray:
+    rec = np.zeros(1, dtype=R.STATE)
+    rec["y"][0] = y0
+    rec["status"] = R.STATUS_RUNNING
+    rec["info_contact"] = -1
+    rec["t_singularity"] = math.nan
+    return rec
+
+
+def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
+    rows = INITIAL_ROWS
+    n_s = min(rows["samples"], max(opts.max_samples, 1))
+    return Problem(
+        model=model_record(scene),
+        points=np.array(contact_points(scene.body, scene.ground), dtype=float, order="C"),
+        options=options_record(scene, t_end, opts),
+        state=initial_record(initial_state(scene.initial)),
+        counters=np.zeros(1, dtype=R.STATS),
+        sample_t=np.zeros((n_s, 2)),
+        sample_y=np.zeros((n_s, 13)),
+        sample_e=np.zeros((n_s, 2)),
+        impacts=np.zeros((rows["impacts"], 6)),
+        phases=np.zeros((rows["phases"], 6)),
+        accumulations=np.zeros(rows["accumulations"]),
+        counts=np.zeros(5, dtype=np.int64),
+    )
+
+
+def run_problem(
+    kernel, problem: Problem, max_samples: int, progress: Callable[[float], None] | None = None
+) -> None:
+    """Call the loop until the run ends: grow the outputs when it asks, report the time
+    reached between calls (a KeyboardInterrupt lands between calls, on a consistent
+    state)."""
+    while True:
+        code = kernel(*problem.arguments())
+        if code == RETURN_DONE:
             return
-        c = _Clock()
-        c.hi, c.lo = self.clock.hi, self.clock.lo
-        if s:
-            c.add(s)
-        m = self.model
-        self.buf.add(c.hi, c.lo, y, m.kinetic_energy(y), m.potential_energy(y))
-
-    def sample_block(self, st: np.ndarray, sy: np.ndarray, se: np.ndarray, ns: int) -> None:
-        """Record the first ns samples a compiled loop wrote (times, states, energies),
-        as many as max_samples leaves room for."""
-        k = min(ns, max(self.opts.max_samples - len(self.buf), 0))
-        self.buf.extend(st[:k], sy[:k], se[:k])
-
-
-def excess_energy(model: BodyModel, y: np.ndarray) -> float:
-    """Energy above the lowest level the invariants allow (body flat on the ground):
-    flat ground: E − ½ m |v_h|² − L_z² / (2 I3); three_point: E − ½ I3 ω3²."""
-    E = model.energy(y)
-    if model.flat:
-        v = y[V]
-        Lz = float(model.angular_momentum(y)[2])
-        return E - 0.5 * model.mass * (v[0] ** 2 + v[1] ** 2) - Lz * Lz / (2 * model.i3)
-    w3 = float(y[W] @ qt.body_axis(y[Q]))
-    return E - 0.5 * model.i3 * w3 * w3
+        if code == RETURN_GROW:
+            problem.grow(max_samples)
+        elif progress is not None:
+            progress(float(problem.state["t_hi"][0]))
 
 
 def simulate(
-    scene: Scene, t_end: float | None = None, options: ReferenceOptions | None = None
+    scene: Scene,
+    t_end: float | None = None,
+    options: ReferenceOptions | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> Trajectory:
-    """Run the exact reference on `scene` until t_end (default scene.run.t_end)."""
+    """Run the exact reference on `scene` until t_end (default scene.run.t_end).
+
+    `progress(t)` is called with the time reached whenever the loop returns to Python
+    (every `options.work_budget` steps).  stats.wall_time_s is the run alone;
+    stats.compile_s the one-time compilation or loading that preceded it."""
     opts = options or ReferenceOptions()
-    wall0 = time.perf_counter()
-    model = BodyModel.from_scene(scene)
+    compile_s = compiled.warm_up()
     t_end = float(t_end if t_end is not None else scene.run.t_end)
-    run = _Run(model, scene.restitution, t_end, opts, max_impacts=scene.run.max_impacts)
-    run.stats.update(
-        flight_search_iterations=0,
-        contact_chunks=0,
-        contact_rhs_evals=0,
-        chatter_completions=0,
-        max_completion_u_rel=0.0,
-        contact_energy_drift_max=0.0,
-        max_penetration=0.0,
-        lift_offs=0,
+    problem = make_problem(scene, t_end, opts)
+    kernel = compiled.run_events()
+    t0 = time.perf_counter()
+    run_problem(kernel, problem, opts.max_samples, progress)
+    wall = time.perf_counter() - t0
+    return _trajectory(scene, problem, opts, t_end, wall, compile_s)
+
+
+def tiny_run(kernel) -> None:
+    """A run of a few events, to compile or load the loop (compiled.warm_up)."""
+    from .scene import scene_from_dict
+
+    scene = scene_from_dict(
+        {
+            "body": {"n": 3},
+            "initial": {"q": [0.01, 0.0, 0.02], "p": [0.0, 0.1, -0.1]},
+            "run": {"t_end": 0.05, "max_impacts": 3},
+        }
     )
-    y = initial_state(scene)
-    run.sample(y)
-    try:
-        status, message, t_sing = _loop(run, y, scene.run.max_impacts)
-    except (RuntimeError, np.linalg.LinAlgError, FloatingPointError) as exc:
-        status, message, t_sing = Status.FAILED, f"{exc} (at t = {run.clock.hi:.17g})", None
-    arrays = run.buf.arrays()
-    run.stats["wall_time_s"] = time.perf_counter() - wall0
-    run.stats["n_impacts"] = len(run.impacts)
-    n = len(run.impacts)
-    run.stats["impacts_per_s"] = n / run.stats["wall_time_s"] if n else 0.0
+    opts = ReferenceOptions(max_samples=64)
+    problem = make_problem(scene, 0.05, opts)
+    run_problem(kernel, problem, opts.max_samples)
+
+
+# ----------------------------------------------------------------------------- result
+
+_STATUS = {
+    R.STATUS_T_END: Status.T_END,
+    R.STATUS_SINGULARITY: Status.SINGULARITY,
+    R.STATUS_ENERGY_EXHAUSTED: Status.SINGULARITY,
+    R.STATUS_AT_REST: Status.SINGULARITY,
+    R.STATUS_SIMULTANEOUS: Status.SIMULTANEOUS_IMPACT,
+    R.STATUS_PUSHED: Status.SIMULTANEOUS_IMPACT,
+    R.STATUS_MAX_IMPACTS: Status.MAX_IMPACTS,
+}
+
+
+def status_message(state: np.void, opts: np.void) -> tuple[Status, str]:
+    """The Trajectory status and its one-sentence message for the loop's end state."""
+    code = int(state["status"])
+    t = float(state["info_t"])
+    contacts = sorted(int(c) for c in state["info"][: int(state["n_info"])])
+    messages = {
+        R.STATUS_T_END: f"reached t_end = {float(opts['t_end']):g}",
+        R.STATUS_SINGULARITY: f"all contacts down at t = {t:.17g}",
+        R.STATUS_ENERGY_EXHAUSTED: (
+            f"energy exhausted to {float(opts['energy_floor']):g} of its initial excess; "
+            "t_singularity extrapolated from the impact intervals"
+        ),
+        R.STATUS_AT_REST: f"at rest on contacts {contacts} at t = {t:.17g}: the motion has ended",
+        R.STATUS_SIMULTANEOUS: f"contacts {contacts} hit simultaneously at t = {t:.17g}",
+        R.STATUS_PUSHED: (
+            f"impact at contact {int(state['info_contact'])} at t = {t:.17g} would push "
+            f"resting contact(s) {contacts} into the ground (undecidable)"
+        ),
+        R.STATUS_MAX_IMPACTS: f"reached max_impacts = {int(opts['max_impacts'])}",
+        R.STATUS_FAILED_NONFINITE: f"non-finite state at t = {t:.17g}",
+        R.STATUS_FAILED_LCP: (
+            f"contact complementarity problem of contacts {contacts} has no solution "
+            f"(at t = {t:.17g})"
+        ),
+        R.STATUS_FAILED_STUCK: f"event search did not converge (at t = {t:.17g})",
+        R.STATUS_FAILED_INTEGRATION: (
+            f"contact integration failed: step size below roundoff (at t = {t:.17g})"
+        ),
+        R.STATUS_FAILED_NO_ADVANCE: (
+            f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0 with contacts "
+            f"{contacts} held)"
+        ),
+    }
+    return _STATUS.get(code, Status.FAILED), messages.get(code, f"loop status {code}")
+
+
+def _trajectory(
+    scene: Scene, p: Problem, opts: ReferenceOptions, t_end: float, wall: float, compile_s: float
+) -> Trajectory:
+    c = p.counts
+    ns, ni, nph, nacc = (int(c[i]) for i in (N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS))
+    state = p.state[0]
+    status, message = status_message(state, p.options[0])
+    t_sing = float(state["t_singularity"])
+    stats = RunStats.from_counters(
+        p.counters[0],
+        wall,
+        compile_s,
+        ni,
+        chatter_accumulation_times=tuple(float(x) for x in p.accumulations[:nacc]),
+        samples=ns,
+    )
     return Trajectory.from_states(
         "reference",
         scene.name,
-        arrays["t"],
-        arrays["states"],
-        arrays["kinetic_energy"],
-        arrays["potential_energy"],
-        run.impacts,
+        p.sample_t[:ns, 0].copy(),
+        p.sample_y[:ns],
+        p.sample_e[:ns, 0].copy(),
+        p.sample_e[:ns, 1].copy(),
+        ImpactLog.from_rows(p.impacts[:ni]),
         status,
-        t_lo=arrays["t_lo"],
-        phases=run.phases,
+        t_lo=p.sample_t[:ns, 1].copy(),
+        phases=PhaseLog(p.phases[:nph]),
         message=message,
-        t_final=run.clock.hi,
-        t_singularity=t_sing,
-        stats=run.stats,
+        t_final=float(state["t_hi"]),
+        t_singularity=None if math.isnan(t_sing) else t_sing,
+        stats=stats,
     )
-
-
-# ----------------------------------------------------------------------------- loop
-
-
-def _loop(run: _Run, y: np.ndarray, max_impacts: int):
-    model = run.model
-    E0 = excess_energy(model, y)
-    gap, _, _, vn, noise = model.contacts(y)
-    vnoise = _rate_noise(model, y)
-    touching = [k for k in range(model.n_contacts) if gap[k] <= noise[k]]
-    hitting = [k for k in touching if vn[k] < -vnoise]
-    resting = [k for k in touching if abs(vn[k]) <= vnoise]  # the rest are separating
-    active: list[int] = []
-    if hitting:
-        out = _resolve(run, y, hitting, resting)
-        if isinstance(out, tuple) and isinstance(out[0], Status):
-            return out
-        y, active = out
-    elif resting:
-        y = project_velocities(model, y, resting)
-        active, _ = solve_contact_lcp(model, y, resting)
-
-    while True:
-        if len(run.impacts) >= max_impacts:
-            return Status.MAX_IMPACTS, f"reached max_impacts = {max_impacts}", None
-        if _all_down(model, active):
-            t = run.clock.hi
-            return Status.SINGULARITY, f"all contacts down at t = {t:.17g}", t
-        if E0 > 0 and excess_energy(model, y) <= run.opts.energy_floor * E0:
-            t_f = _extrapolate_singularity(run)
-            return (
-                Status.SINGULARITY,
-                f"energy exhausted to {run.opts.energy_floor:g} of its initial excess; "
-                f"t_singularity extrapolated from the impact intervals",
-                t_f,
-            )
-        remaining = run.clock.minus(run.t_end)
-        remaining = -remaining
-        if remaining <= 0:
-            return Status.T_END, f"reached t_end = {run.t_end}", None
-        if active:
-            out = _contact_phase(run, y, active, remaining)
-        else:
-            out = _flight_phase(run, y, remaining)
-        if out is None:
-            return Status.T_END, f"reached t_end = {run.t_end}", None
-        if isinstance(out[0], Status):
-            return out
-        y, active = out
-        if not np.all(np.isfinite(y)):
-            return Status.FAILED, f"non-finite state at t = {run.clock.hi}", None
-
-
-def _rate_noise(model: BodyModel, y: np.ndarray) -> float:
-    return 64 * np.finfo(float).eps * model.velocity_scale(y)
-
-
-def _all_down(model: BodyModel, active: list[int]) -> bool:
-    need = 2 if (model.flat and model.n_contacts == 2) else 3
-    return len(active) >= need
-
-
-def _extrapolate_singularity(run: _Run) -> float:
-    """t_f from the last three impacts assuming geometric intervals τ_{k+1} = r τ_k."""
-    imp = run.impacts
-    if len(imp) < 3:
-        return run.clock.hi
-    t = [(e.t, e.t_lo) for e in imp[-3:]]
-    tau1 = (t[1][0] - t[0][0]) + (t[1][1] - t[0][1])
-    tau2 = (t[2][0] - t[1][0]) + (t[2][1] - t[1][1])
-    if tau1 <= 0 or not 0 < tau2 / tau1 < 1:
-        return run.clock.hi
-    r = tau2 / tau1
-    return t[2][0] + (t[2][1] + tau2 * r / (1 - r))
-
-
-# ----------------------------------------------------------------------------- phases
-
-
-def _flight_phase(run: _Run, y: np.ndarray, remaining: float):
-    model = run.model
-    if model.flat and events_mod.USE_KERNEL and run.gamma > 0.0:
-        done, y = _bounce_compiled(run, y)
-        if done:
-            return None  # t_end reached in flight
-        if len(run.impacts) >= run.max_impacts:
-            return y, []
-        remaining = run.t_end - run.clock.hi - run.clock.lo
-        if remaining <= 0:
-            return None
-    fc = flight_constants(model, y)
-    ev = next_flight_event(model, fc, remaining)
-    s_end = remaining if ev is None else ev.s
-    _sample_grid(run, lambda s: free_flight(fc, s), s_end)
-    t0 = run.clock.hi
-    if ev is None:
-        y = free_flight(fc, remaining)
-        run.clock.add(remaining)
-        run.sample(y)
-        run.phases.append(Phase(t0, run.clock.hi, "flight"))
-        return None
-    run.stats["flight_search_iterations"] += ev.iterations
-    run.clock.add(ev.s)
-    run.phases.append(Phase(t0, run.clock.hi, "flight"))
-    run.sample(ev.y)
-    if ev.kind == "activation":
-        return _activate(run, ev.y, list(ev.contacts), [])
-    return _resolve(run, ev.y, list(ev.contacts), [])
-
-
-def _bounce_compiled(run: _Run, y: np.ndarray) -> tuple[bool, np.ndarray]:
-    """Run the compiled flight/impact loop (reference.flight_kernel.bounce_loop) for as
-    long as impacts are plain single impacts.  Returns (reached t_end, state); when it
-    stops early the state is just before an event that the Python path resolves."""
-    from . import flight_kernel as fk
-
-    m = run.model
-    cap = 4096
-    imp = np.empty((cap, 6))
-    st = np.empty((2 * cap + 64, 2))
-    sy = np.empty((2 * cap + 64, 13))
-    se = np.empty((2 * cap + 64, 2))
-    sample_dt = run.opts.sample_dt or run.t_end / 2000.0
-    while True:
-        left = run.max_impacts - len(run.impacts)
-        t0 = run.clock.hi
-        wall0 = time.perf_counter()
-        code, y, hi, lo, n_imp, ns, iters, _k = fk.bounce_loop(
-            y,
-            m.mass,
-            m.i1,
-            m.i3,
-            m.gravity,
-            run.gamma,
-            m.points,
-            m.radius,
-            run.opts.chatter_tol,
-            run.clock.hi,
-            run.clock.lo,
-            run.t_end,
-            left,
-            sample_dt,
-            100_000,
-            imp,
-            st,
-            sy,
-            se,
-        )
-        run.stats["flight_search_iterations"] += int(iters)
-        run.stats["bounce_loop_s"] = run.stats.get("bounce_loop_s", 0.0) + (
-            time.perf_counter() - wall0
-        )
-        run.stats["bounce_loop_impacts"] = run.stats.get("bounce_loop_impacts", 0) + int(n_imp)
-        run.impacts.extend_rows(imp[:n_imp])
-        run.sample_block(st, sy, se, ns)
-        run.clock.hi, run.clock.lo = float(hi), float(lo)
-        if n_imp:
-            run.phases.append(Phase(t0, run.clock.hi, "flight"))
-        if code == fk.EXIT_FULL:
-            continue
-        if code == fk.EXIT_STUCK:
-            raise RuntimeError("event search did not converge (max_iter)")
-        if code == fk.EXIT_T_END:
-            run.sample(y)
-            return True, y
-        return False, y
-
-
-def _sample_grid(run: _Run, state_at, s_end: float) -> None:
-    dt = run.opts.sample_dt or run.t_end / 2000.0
-    k0 = math.floor(run.clock.hi / dt) + 1
-    while True:
-        s = k0 * dt - run.clock.hi - run.clock.lo
-        if s >= s_end:
-            break
-        if s > 0:
-            run.sample(state_at(s), s)
-        k0 += 1
-
-
-def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float):
-    model = run.model
-    t0 = run.clock.hi
-    E_start = model.energy(y)
-    lam_prev, h_prev = None, None
-    s_done = 0.0
-    # Gap resolution in a contact phase: roundoff, or the integrator's tolerance on the
-    # positions (it resolves gaps only to ~rtol of the phase's length scale).
-    gap_res = 16 * run.opts.contact_rtol * model.length_scale(y)
-    compiled = model.flat and USE_CONTACT_KERNEL and 1 <= len(active) <= 2
-    while True:
-        if compiled:
-            # the compiled loop runs the plain chunks; it stops at anything that is an
-            # event, and a chunk it hands back (lift-off or crossing inside) is redone
-            # below once, with dense output and root finding, before it runs again
-            y, ds, lam_prev, h_prev, code = _contact_compiled(
-                run, y, active, remaining - s_done, gap_res, lam_prev, h_prev
-            )
-            s_done += ds
-            if code == "t_end":
-                run.sample(y)
-                _close_contact_phase(run, t0, active, E_start, y)
-                return None
-        compiled = model.flat and USE_CONTACT_KERNEL and 1 <= len(active) <= 2
-        acc = constrained_acceleration(model, y, active)
-        jet = gap_jet(model, y, acc)
-        vnoise = _rate_noise(model, y)
-        held = np.zeros(model.n_contacts, dtype=bool)
-        held[active] = True
-        touching = ~held & (jet.gap <= np.maximum(jet.noise, gap_res))
-        hitting = np.flatnonzero(touching & (jet.rate < -vnoise)).tolist()
-        if hitting:
-            _close_contact_phase(run, t0, active, E_start, y)
-            return _resolve(run, y, hitting, list(active))
-        landing = np.flatnonzero(touching & (jet.rate <= vnoise) & (jet.accel < 0)).tolist()
-        if landing:
-            _close_contact_phase(run, t0, active, E_start, y)
-            return _activate(run, y, landing, list(active))
-        lam = contact_forces(model, y, active)
-        h = chunk_horizon(model, y, jet, held)
-        if lam_prev is not None and h_prev:
-            rate = (lam - lam_prev) / h_prev
-            for i in range(len(lam)):
-                if rate[i] < 0 and lam[i] > 0:
-                    h = min(h, 1.5 * lam[i] / -rate[i])
-        h = min(h, remaining - s_done)
-        if h <= 0:
-            _close_contact_phase(run, t0, active, E_start, y)
-            if remaining - s_done <= 0:
-                return None
-            # a zero chunk before t_end: some contact sits on the ground with no event
-            # the model recognises; say so rather than end as if t_end were reached
-            return (
-                Status.FAILED,
-                f"contact phase cannot advance at t = {run.clock.hi:.17g} "
-                f"(chunk horizon {h:g} with contacts {active} held)",
-                None,
-            )
-        y_new, sol, nfev = integrate_chunk(model, y, active, h, run.opts.contact_rtol, dense=True)
-        run.stats["contact_chunks"] += 1
-        run.stats["contact_rhs_evals"] += nfev
-        lam_new = contact_forces(model, y_new, active)
-        # penetration guard for the other contacts (must not happen: conservative horizon)
-        # (every vertex below the ground at the chunk's end lies in near_ground(0))
-        below = model.near_ground(y_new, 0.0)
-        below = below[~held[below]]
-        gap_new, _, _, _, noise_new = model.contacts(y_new, below)
-        crossed = below[gap_new < -np.maximum(noise_new, gap_res)].tolist()
-        if crossed:
-            # the horizon bound was not enough: find the first crossing on the dense
-            # output and stop there (counted: the bound should make this rare)
-            run.stats["horizon_backstops"] = run.stats.get("horizon_backstops", 0) + 1
-
-            def min_gap(s, sol=sol, crossed=crossed):
-                return float(np.min(model.contacts(sol(s), crossed)[0]))
-
-            s_star = _first_zero(min_gap, h)
-            y, _, nfev = integrate_chunk(model, y, active, s_star, run.opts.contact_rtol)
-            _sample_grid(run, sol, s_star)
-            run.clock.add(s_star)
-            s_done += s_star
-            lam_prev, h_prev = None, None
-            continue
-        if np.any(lam_new < 0):
-            i = int(np.argmin(lam_new))
-
-            def lam_i(s, i=i, sol=sol):
-                return contact_forces(model, sol(s), active)[i]
-
-            s_star = _first_zero(lam_i, h)
-            if s_star > 0:
-                y, _, nfev = integrate_chunk(model, y, active, s_star, run.opts.contact_rtol)
-                run.stats["contact_rhs_evals"] += nfev
-            _sample_grid(run, sol, s_star)
-            run.clock.add(s_star)
-            run.sample(y)
-            run.stats["lift_offs"] += 1
-            _close_contact_phase(run, t0, active, E_start, y)
-            leaving = active[i]
-            rest = [k for k in active if k != leaving]
-            if rest:
-                y = project_velocities(model, y, rest)
-                rest, _ = solve_contact_lcp(model, y, rest)
-            return y, rest
-        _sample_grid(run, sol, h)
-        run.clock.add(h)
-        s_done += h
-        y = y_new
-        lam_prev, h_prev = lam_new, h
-        if remaining - s_done <= 0:
-            run.sample(y)
-            _close_contact_phase(run, t0, active, E_start, y)
-            return None
-
-
-def _contact_compiled(run: _Run, y, active, left, gap_res, lam_prev, h_prev):
-    """Run reference.contact_kernel.contact_loop from y with `active` held; returns
-    (y, time advanced, lam_prev, h_prev, "t_end" | "python"): "python" leaves the next
-    step (an event at y, or a chunk to redo from y) to the Python loop."""
-    from . import contact_kernel as ck
-
-    m = run.model
-    sample_dt = run.opts.sample_dt or run.t_end / 2000.0
-    cap = 4096
-    st, sy, se = np.empty((cap, 2)), np.empty((cap, 13)), np.empty((cap, 2))
-    lp = np.zeros(2)
-    if lam_prev is not None:
-        lp[: len(lam_prev)] = lam_prev
-    hp = h_prev or 0.0
-    s_total = 0.0
-    while True:
-        code, y, hi, lo, ds, chunks, nfev, ns, hp = ck.contact_loop(
-            y,
-            np.asarray(active, dtype=np.int64),
-            m.points,
-            m.mass,
-            m.i1,
-            m.i3,
-            m.gravity,
-            m.radius,
-            run.opts.contact_rtol,
-            gap_res,
-            run.clock.hi,
-            run.clock.lo,
-            left - s_total,
-            sample_dt,
-            lp,
-            hp,
-            st,
-            sy,
-            se,
-        )
-        run.stats["contact_chunks"] += int(chunks)
-        run.stats["contact_rhs_evals"] += int(nfev)
-        run.stats["compiled_contact_chunks"] = run.stats.get("compiled_contact_chunks", 0) + int(
-            chunks
-        )
-        run.sample_block(st, sy, se, ns)
-        run.clock.hi, run.clock.lo = float(hi), float(lo)
-        s_total += ds
-        if code != ck.EXIT_FULL:
-            break
-    lam_out = lp[: len(active)].copy() if hp > 0 else None
-    kind = "t_end" if code == ck.EXIT_T_END else "python"
-    return y, s_total, lam_out, (hp if hp > 0 else None), kind
-
-
-def _first_zero(f, h: float) -> float:
-    """Root of f on [0, h] (brentq); 0 when f(0) ≤ 0 already (a force that is zero or
-    pulling at the start of the chunk lifts off at once); h when the dense output has
-    not crossed yet at h (the projected end state has: the crossing is within the
-    interpolation error of the chunk end)."""
-    if f(0.0) <= 0.0:
-        return 0.0
-    if f(h) >= 0.0:
-        return h
-    return brentq(f, 0.0, h, xtol=1e-15 * h, rtol=4 * np.finfo(float).eps)
-
-
-def _close_contact_phase(run: _Run, t0, active, E_start, y) -> None:
-    run.phases.append(Phase(t0, run.clock.hi, "contact", tuple(active)))
-    E = run.model.energy(y)
-    drift = abs(E - E_start) / max(abs(E_start), 1e-300)
-    run.stats["contact_energy_drift_max"] = max(run.stats["contact_energy_drift_max"], drift)
-
-
-# ----------------------------------------------------------------------------- impacts
-
-
-def _activate(run: _Run, y: np.ndarray, landing: list[int], held: list[int]):
-    """Contacts touching with no approach speed whose normal acceleration points into
-    the ground start to be held (no impulse beyond zeroing roundoff-level velocities)."""
-    candidates = sorted(set(held) | set(landing))
-    y = apply_normal_impulses(run.model, y, candidates, np.zeros(len(candidates)))
-    active, _ = solve_contact_lcp(run.model, y, candidates)
-    run.stats["activations"] = run.stats.get("activations", 0) + 1
-    if sorted(active) == sorted(held):
-        # the LCP does not hold them (roundoff tie): hold them anyway, the force check
-        # of the contact phase releases them if they pull
-        active = candidates
-    return y, active
-
-
-def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
-    """Impact of `hitting` (one contact) while `resting` are held.  Returns (y, active)
-    or a (Status, message, t_singularity) triple when the model cannot decide."""
-    model = run.model
-    t = run.clock.hi
-    if len(hitting) > 1:
-        return (
-            Status.SIMULTANEOUS_IMPACT,
-            f"contacts {hitting} hit simultaneously at t = {t:.17g}",
-            None,
-        )
-    k = hitting[0]
-    gap_k = float(model.contacts(y, [k])[0][0])
-    run.stats["max_penetration"] = max(run.stats["max_penetration"], -gap_k)
-    res = impact_impulse(model, y, k, run.gamma, watch=list(resting))
-    vnoise = _rate_noise(model, y)
-    pushed = [j for j in resting if res.others_post[j] < -vnoise]
-    if pushed:
-        return (
-            Status.SIMULTANEOUS_IMPACT,
-            f"impact at contact {k} at t = {t:.17g} would push resting contact(s) "
-            f"{pushed} into the ground (undecidable)",
-            None,
-        )
-    run.impacts.append(
-        ImpactEvent(
-            t=t,
-            t_lo=run.clock.lo,
-            contact=k,
-            impulse=res.impulse,
-            v_normal_pre=res.u_pre,
-            v_normal_post=res.u_post,
-        )
-    )
-    y = res.y_post
-    # Completion threshold: below it a separation speed is completed (γ < 1 only: an
-    # elastic contact never accumulates impacts).
-    # A bounce is resolvable only while its height u²/(2|a_n|) stays above the gap's
-    # roundoff band: below u_floor = 100 √(2 |a_n| noise) (height 1e4 noise bands, event
-    # times good to 1e-4 of a bounce) completion takes over.
-    small = run.opts.chatter_tol * model.velocity_scale(y) if run.gamma < 1.0 else vnoise
-    if run.gamma < 1.0:
-        noise_k = float(model.contacts(y, [k])[4][0])
-        a_scale = model.gravity + model.radius * float(y[W] @ y[W])
-        small = max(small, 100.0 * math.sqrt(2.0 * a_scale * noise_k))
-    small = max(small, vnoise)
-    # resting contacts the impact leaves at rest or separating slower than `small`
-    # (two-point chatter: the body rocks between two contacts with shrinking speeds)
-    candidates = [j for j in resting if res.others_post[j] <= small]
-    u = res.u_post
-    if u <= vnoise and run.gamma == 0.0:
-        candidates.append(k)
-    elif u <= small:
-        # would k fall back?  normal acceleration with the other candidates held
-        acc = constrained_acceleration(model, y, candidates)
-        a_n = float(gap_jet(model, y, acc, [k]).accel[0])
-        if a_n < 0 or u <= vnoise:
-            run.stats["chatter_completions"] += 1
-            rel = u / model.velocity_scale(y)
-            run.stats["max_completion_u_rel"] = max(run.stats["max_completion_u_rel"], rel)
-            t_acc = t + 2.0 * max(u, 0.0) / (max(-a_n, 1e-300) * (1.0 - run.gamma))
-            run.stats.setdefault("chatter_accumulation_times", []).append(t_acc)
-            candidates.append(k)
-    for j in candidates:
-        if j != k and res.others_post[j] > vnoise:
-            rel = res.others_post[j] / model.velocity_scale(y)
-            run.stats["max_completion_u_rel"] = max(run.stats["max_completion_u_rel"], rel)
-    if candidates:
-        y = apply_normal_impulses(model, y, candidates, np.zeros(len(candidates)))
-        active, _ = solve_contact_lcp(model, y, candidates)
-    else:
-        active = []
-    run.sample(y)
-    return y, active

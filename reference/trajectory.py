@@ -14,7 +14,7 @@ normal impulse and the pre/post normal velocities of the contact point.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
@@ -77,8 +77,8 @@ class Trajectory:
     message: str = ""
     t_final: float = 0.0
     t_singularity: float | None = None
-    phases: list[Phase] = field(default_factory=list)
-    stats: dict[str, Any] = field(default_factory=dict)
+    phases: Sequence[Phase] = field(default_factory=list)  # a list or a PhaseLog
+    stats: Mapping[str, Any] = field(default_factory=dict)  # a dict, or RunStats
     t_lo: np.ndarray | None = None
     dt: float | None = None  # fixed timestep of an engine run, None for event-driven
 
@@ -129,13 +129,18 @@ class Trajectory:
         return None if w is None else float(w)
 
     @property
+    def compile_s(self) -> float:
+        """One-time compilation or loading of compiled code before this run (0 if warm)."""
+        return float(self.stats.get("compile_s") or 0.0)
+
+    @property
     def energy(self) -> np.ndarray:
         return self.kinetic_energy + self.potential_energy
 
     @property
     def inclination(self) -> np.ndarray:
         """α(t): angle between the body axis and the vertical."""
-        return np.array([qt.inclination(q) for q in self.quaternion])
+        return np.atleast_1d(qt.inclination(self.quaternion)) if self.n_samples else np.zeros(0)
 
     @property
     def n_samples(self) -> int:
@@ -174,7 +179,9 @@ class Trajectory:
                 "final": float(self.energy[-1]) if self.n_samples else None,
             },
             "final_state": self.final_state() if self.n_samples else None,
-            "stats": _jsonable(self.stats),
+            "stats": _jsonable(
+                self.stats.to_dict() if hasattr(self.stats, "to_dict") else dict(self.stats)
+            ),
         }
         if self.dt is not None:
             doc["dt"] = self.dt
@@ -195,61 +202,6 @@ def _jsonable(x: Any) -> Any:
     if isinstance(x, float) and not np.isfinite(x):
         return None
     return x
-
-
-class SampleBuffer:
-    """Accumulates samples of a run in growing arrays (doubling capacity), one row at a
-    time from Python or a block at a time from the compiled loop, then freezes them into
-    a Trajectory's arrays."""
-
-    def __init__(self, capacity: int = 1024) -> None:
-        self.n = 0
-        self._t = np.empty((capacity, 2))  # t_hi, t_lo
-        self._y = np.empty((capacity, 13))
-        self._e = np.empty((capacity, 2))  # kinetic, potential
-
-    def __len__(self) -> int:
-        return self.n
-
-    def _reserve(self, k: int) -> None:
-        need = self.n + k
-        if need <= len(self._t):
-            return
-        cap = max(need, 2 * len(self._t))
-        for name in ("_t", "_y", "_e"):
-            old = getattr(self, name)
-            new = np.empty((cap, old.shape[1]))
-            new[: self.n] = old[: self.n]
-            setattr(self, name, new)
-
-    def add(self, t_hi: float, t_lo: float, y: np.ndarray, ke: float, pe: float) -> None:
-        self._reserve(1)
-        i = self.n
-        self._t[i] = (t_hi, t_lo)
-        self._y[i] = y
-        self._e[i] = (ke, pe)
-        self.n = i + 1
-
-    def extend(self, t: np.ndarray, y: np.ndarray, e: np.ndarray) -> None:
-        """Append k rows: t (k, 2) = (t_hi, t_lo), y (k, 13) states, e (k, 2) = (KE, PE)."""
-        k = len(t)
-        self._reserve(k)
-        self._t[self.n : self.n + k] = t
-        self._y[self.n : self.n + k] = y
-        self._e[self.n : self.n + k] = e
-        self.n += k
-
-    def arrays(self) -> dict[str, np.ndarray]:
-        """Copies of the samples so far: t, t_lo, states (n, 13), kinetic and potential
-        energy."""
-        n = self.n
-        return {
-            "t": self._t[:n, 0].copy(),
-            "t_lo": self._t[:n, 1].copy(),
-            "states": self._y[:n].copy(),
-            "kinetic_energy": self._e[:n, 0].copy(),
-            "potential_energy": self._e[:n, 1].copy(),
-        }
 
 
 class ImpactLog(Sequence[ImpactEvent]):
@@ -287,6 +239,13 @@ class ImpactLog(Sequence[ImpactEvent]):
             e.v_normal_post,
         )
         self._n += 1
+
+    @classmethod
+    def from_rows(cls, rows: np.ndarray) -> ImpactLog:
+        """A log holding rows laid out as COLUMNS (copied)."""
+        log = cls()
+        log.extend_rows(np.asarray(rows, dtype=float).reshape(-1, 6))
+        return log
 
     def extend_rows(self, rows: np.ndarray) -> None:
         """Append rows laid out as COLUMNS."""
@@ -331,3 +290,32 @@ class ImpactLog(Sequence[ImpactEvent]):
 
     def __repr__(self) -> str:
         return f"ImpactLog({self._n} impacts)"
+
+
+class PhaseLog(Sequence[Phase]):
+    """Phases as rows (t_start, t_end, kind, contact0, contact1, contact2) with kind
+    0 = flight, 1 = contact and −1 padding, read as a sequence of `Phase`."""
+
+    KINDS = ("flight", "contact")
+
+    def __init__(self, rows: np.ndarray) -> None:
+        self._rows = np.asarray(rows, dtype=float).reshape(-1, 6).copy()
+
+    def __len__(self) -> int:
+        return len(self._rows)
+
+    def _phase(self, r: np.ndarray) -> Phase:
+        contacts = tuple(int(c) for c in r[3:6] if c >= 0)
+        return Phase(float(r[0]), float(r[1]), self.KINDS[int(r[2])], contacts)
+
+    def __getitem__(self, i):  # type: ignore[override]
+        if isinstance(i, slice):
+            return [self._phase(r) for r in self._rows[i]]
+        return self._phase(self._rows[i])
+
+    def __iter__(self) -> Iterator[Phase]:
+        for r in self._rows:
+            yield self._phase(r)
+
+    def __repr__(self) -> str:
+        return f"PhaseLog({len(self)} phases)"

@@ -18,8 +18,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 from reference import quaternion as qt
-from reference.body import BodyModel
-from reference.flight import flight_constants, free_flight
+from reference.core.contacts import vertex_lever
+from reference.core.flight import flight_constants, free_flight
+from reference.geometry import scene_contact_kinematics
 from reference.scene import Body, Ground, InitialState, Scene
 
 OUT = Path(__file__).resolve().parent.parent / "harness" / "scenes"
@@ -69,20 +70,22 @@ def _scene(n, rho, y):
 
 def grazing() -> str:
     n, rho, w, tilt = 3, 0.5, -5.0, 0.1
-    model = BodyModel.from_scene(_scene(n, rho, np.r_[0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0]))
+    scene = _scene(n, rho, np.r_[0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0])
     y = np.zeros(13)
     # vertex 0 at body (1, 0, 0); tilt about y so it is the lowest point
     y[3:7] = qt.from_rotation_vector([0.02, tilt, 0.0])  # asymmetric: no mirror hits
     # horizontal spin: centripetal (ω×(ω×r))_z = −|ω|² r_z > 0 lifts the low vertex 0;
     # v_z cancels (ω × r)_z so vertex 0 touches with zero normal velocity
     y[10:13] = [0.5, w, 0.0]
-    gap, _, lever, _, _ = model.contacts(y)
-    y[2] = -lever[0, 2]  # vertex 0 exactly on the ground
-    y[9] = -(y[10] * lever[0, 1] - y[11] * lever[0, 0])
-    g, _, _, vn, _ = model.contacts(y)
-    assert abs(g[0]) < 1e-15 and abs(vn[0]) < 1e-14, (g, vn)
-    back = free_flight(flight_constants(model, y), -T_GRAZE)
-    assert np.all(model.contacts(back)[0] > 0)
+    rx, ry, rz = vertex_lever(y, 1.0, 0.0)
+    y[2] = -rz  # vertex 0 exactly on the ground
+    y[9] = -(y[10] * ry - y[11] * rx)
+    g, vn = scene_contact_kinematics(scene, y)
+    assert abs(g[0, 0]) < 1e-15 and abs(vn[0, 0]) < 1e-14, (g, vn)
+    i1, _, i3 = scene.body.inertia_diag
+    back = np.empty(13)
+    free_flight(y, flight_constants(y, i1, i3), scene.gravity, -T_GRAZE, back)
+    assert np.all(scene_contact_kinematics(scene, back)[0] > 0)
     return _toml(
         "grazing-contact",
         f"triangle whose vertex 0 grazes the ground (double root) at t = {T_GRAZE}",
@@ -96,24 +99,26 @@ def grazing() -> str:
 
 def near_simultaneous() -> str:
     n, rho, v, h0 = 4, 0.5, -1.0, 0.05
-    model = BodyModel.from_scene(_scene(n, rho, np.r_[0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0]))
+    scene = _scene(n, rho, np.r_[0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0])
     phiy = 0.02
+
+    def gaps(y):
+        return scene_contact_kinematics(scene, y)[0][0]
 
     def state(phix):
         y = np.zeros(13)
         y[3:7] = qt.from_rotation_vector([phix, phiy, 0.0])
-        gap = model.contacts(y)[0]
-        y[2] = h0 - gap[0]
+        y[2] = h0 - gaps(y)[0]
         y[9] = v
         return y
 
     def diff(phix):
-        g = model.contacts(state(phix))[0]
+        g = gaps(state(phix))
         return (g[1] - g[0]) - DT_APART * abs(v)
 
     phix = brentq(diff, -0.03, -0.01, xtol=1e-17, rtol=1e-15)
     y = state(phix)
-    g = model.contacts(y)[0]
+    g = gaps(y)
     assert abs((g[1] - g[0]) - DT_APART) < 1e-15 and g[0] == min(g)
     return _toml(
         "near-simultaneous",

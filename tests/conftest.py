@@ -44,3 +44,43 @@ def make_scene(
 @pytest.fixture
 def scene_factory():
     return make_scene
+
+
+def core_model(scene: Scene):
+    """(model record, contact points) of a scene, as the compiled core reads them."""
+    from reference.geometry import contact_points
+    from reference.simulate import model_record
+
+    return model_record(scene)[0], np.array(contact_points(scene.body, scene.ground), order="C")
+
+
+def flight(scene: Scene, y0: np.ndarray, s: float) -> np.ndarray:
+    """The state after a closed-form free flight of s from y0 (reference.core.flight)."""
+    from reference.core.flight import flight_constants, free_flight
+
+    i1, _, i3 = scene.body.inertia_diag
+    out = np.empty(13)
+    free_flight(np.asarray(y0, dtype=float), flight_constants(y0, i1, i3), scene.gravity, s, out)
+    return out
+
+
+def gaps(scene: Scene, y: np.ndarray) -> np.ndarray:
+    """Contact gaps (k,) of one state."""
+    from reference.geometry import scene_contact_kinematics
+
+    return scene_contact_kinematics(scene, y)[0][0]
+
+
+def angular_momentum(scene: Scene, states: np.ndarray) -> np.ndarray:
+    """(N, 3) angular momentum about the centre of mass, I_w ω with
+    I_w = i1 1 + (i3 − i1) e3 e3ᵀ, from the states (written here for the tests)."""
+    states = np.atleast_2d(states)
+    i1, _, i3 = scene.body.inertia_diag
+    e3 = qt.body_axis(states[:, 3:7])
+    w = states[:, 10:13]
+    return i1 * w + (i3 - i1) * np.sum(w * e3, axis=1)[:, None] * e3
+
+
+def states_of(traj) -> np.ndarray:
+    """(N, 13) sample states of a Trajectory."""
+    return np.hstack([traj.position, traj.quaternion, traj.velocity, traj.angular_velocity])

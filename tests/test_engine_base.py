@@ -8,8 +8,8 @@ import pytest
 
 from engines.base import contact_kinematics, energies, impacts_from_contact_activity
 from reference import quaternion as qt
-from reference.body import BodyModel
 from tests.conftest import make_scene
+from tests.oracle.body import BodyModel
 
 
 @pytest.mark.parametrize("ground", ["flat", "three_point"])

@@ -19,8 +19,8 @@ from engines.mujoco import (
 )
 from engines.mujoco_model import load_model
 from engines.mujoco_restitution import effective_restitution, single_vertex_drop
-from reference.body import BodyModel, initial_state
 from reference.scene import scene_from_dict
+from tests.oracle.body import BodyModel, initial_state
 
 
 def make_scene(initial, n=5, gamma=0.5, ground=None, mass=1.0, t_end=1.0, gravity=1.0):

@@ -22,9 +22,9 @@ from engines.pybullet import (
 from engines.pybullet_restitution import single_vertex_restitution, single_vertex_scene
 from harness.scenes import resolve_scene
 from reference import quaternion as qt
-from reference.body import initial_state
 from reference.scene import scene_from_dict
 from reference.trajectory import Status
+from tests.oracle.body import initial_state
 
 EPS = np.finfo(float).eps
 

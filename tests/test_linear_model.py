@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from reference import quaternion as qt
-from reference.body import BodyModel, initial_state
 from reference.linear.model import (
     LinearModel,
     full_states,
@@ -15,6 +14,7 @@ from reference.linear.model import (
     polygon_points,
 )
 from reference.scene import initial_from_linear, scene_from_dict
+from tests.oracle.body import BodyModel, initial_state
 
 
 def _scene(n=5, ground="flat", q=(0.0, 0.0, 1.0), p=(0.0, 0.0, 0.0), rho=0.4, bump=0.5):

@@ -26,9 +26,9 @@ from harness.recording.loglog import (
     time_to_go,
 )
 from reference import quaternion as qt
-from reference.body import BodyModel
 from reference.scene import scene_from_dict
 from reference.trajectory import ImpactEvent, Status, Trajectory
+from tests.oracle.body import BodyModel
 
 RERUN_CLI = Path(sys.executable).parent / "rerun"
 T_F = 2.0

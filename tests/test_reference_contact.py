@@ -7,26 +7,28 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from reference import quaternion as qt
-from reference.body import BodyModel
-from reference.contact import contact_forces
+from reference.core.contacts import vertex_lever
+from reference.core.held import held_forces, new_work
+from reference.geometry import contact_points, scene_contact_kinematics
 from reference.simulate import simulate
-from tests.conftest import make_scene
+from tests.conftest import core_model, make_scene
 
 
-def newton_euler_single_contact(model: BodyModel, y: np.ndarray, k: int):
+def newton_euler_single_contact(scene, y: np.ndarray, k: int):
     """Paper eqs. (rollF), (rollM), (rollc) for one flat-ground contact as a 7×7 linear
-    system in (v̇, ω̇, η), assembled here independently of reference.contact."""
+    system in (v̇, ω̇, η), assembled here independently of the core."""
     q, w = y[3:7], y[10:13]
-    R = qt.to_matrix(q)
-    r = R @ model.points[k]
-    Ib = np.diag([model.i1, model.i1, model.i3])
-    Iw = R @ Ib @ R.T
+    r = qt.rotate(q, contact_points(scene.body, scene.ground)[k])
+    i1, _, i3 = scene.body.inertia_diag
+    e = [qt.rotate(q, axis) for axis in np.eye(3)]
+    Iw = sum(i * np.outer(a, a) for i, a in zip((i1, i1, i3), e, strict=True))
+    mass, g = scene.body.mass, scene.gravity
     ez = np.array([0.0, 0.0, 1.0])
     M = np.zeros((7, 7))
     rhs = np.zeros(7)
-    M[0:3, 0:3] = model.mass * np.eye(3)
+    M[0:3, 0:3] = mass * np.eye(3)
     M[0:3, 6] = -ez
-    rhs[0:3] = -model.mass * model.gravity * ez
+    rhs[0:3] = -mass * g * ez
     M[3:6, 3:6] = Iw
     M[3:6, 6] = -np.cross(r, ez)
     rhs[3:6] = -np.cross(w, Iw @ w)
@@ -37,39 +39,46 @@ def newton_euler_single_contact(model: BodyModel, y: np.ndarray, k: int):
     return np.linalg.solve(M, rhs)
 
 
-def rocking_state(model, wy=1.5, wz=0.0, tilt=0.3):
-    """Vertex 0 on the ground with zero normal velocity, body rocking about world y."""
+def rocking_state(wy=1.5, wz=0.0, tilt=0.3):
+    """Vertex 0 (body point (1, 0, 0)) on the ground with zero normal velocity, the body
+    rocking about world y."""
     y = np.zeros(13)
     y[3:7] = qt.from_rotation_vector([0.0, tilt, 0.0])
     y[10:13] = [0.0, wy, wz]
-    _, _, lever, _, _ = model.contacts(y)
-    y[2] = -lever[0, 2]
-    y[9] = -(y[10] * lever[0, 1] - y[11] * lever[0, 0])
+    rx, ry, rz = vertex_lever(y, 1.0, 0.0)
+    y[2] = -rz
+    y[9] = -(y[10] * ry - y[11] * rx)
     return y
 
 
+def contact_force(scene, y, k):
+    model, pts = core_model(scene)
+    work = new_work()
+    _, ok = held_forces(y, model, pts, np.array([k, 0, 0]), 1, work)
+    assert ok
+    return work.lam[0]
+
+
 def test_single_contact_force_matches_independent_newton_euler_solve():
-    model = BodyModel.from_scene(make_scene(n=5, rho=0.41))
-    y = rocking_state(model, wy=0.7, wz=1.3, tilt=0.2)
-    eta = contact_forces(model, y, [0])[0]
-    expect = newton_euler_single_contact(model, y, 0)[6]
-    assert abs(eta - expect) < 1e-13 * abs(expect)
+    scene = make_scene(n=5, rho=0.41)
+    y = rocking_state(wy=0.7, wz=1.3, tilt=0.2)
+    expect = newton_euler_single_contact(scene, y, 0)[6]
+    assert abs(contact_force(scene, y, 0) - expect) < 1e-13 * abs(expect)
 
 
 def test_contact_force_at_rest_small_tilt_is_the_papers_closed_form():
     """Linearised model (paper eq. under (pacccontact)): η = m g / (1 + ρ⁻²)."""
     for rho in (0.3, 0.5, 0.8):
-        model = BodyModel.from_scene(make_scene(n=5, rho=rho))
-        y = rocking_state(model, wy=0.0, wz=0.0, tilt=1e-7)
-        eta = contact_forces(model, y, [0])[0]
-        assert abs(eta - 1.0 / (1.0 + rho**-2)) < 1e-12
+        scene = make_scene(n=5, rho=rho)
+        y = rocking_state(wy=0.0, wz=0.0, tilt=1e-7)
+        assert abs(contact_force(scene, y, 0) - 1.0 / (1.0 + rho**-2)) < 1e-12
 
 
 def test_lift_off_time_is_where_the_force_crosses_zero():
     """Reference lift-off against scipy's event location on an independently written
     constrained RHS (the 7×7 solve above), DOP853 at rtol 1e-12."""
-    model = BodyModel.from_scene(make_scene(n=3, gamma=0.0))
-    y0 = rocking_state(model, wy=1.5)
+    scene0 = make_scene(n=3, gamma=0.0)
+    y0 = rocking_state(wy=1.5)
     traj = simulate(make_scene(n=3, gamma=0.0, state=y0, t_end=0.5))
     assert traj.stats["lift_offs"] >= 1
     contact = traj.phases[0]
@@ -77,7 +86,7 @@ def test_lift_off_time_is_where_the_force_crosses_zero():
     t_ref = contact.t_end
 
     def rhs(_t, y):
-        sol = newton_euler_single_contact(model, y, 0)
+        sol = newton_euler_single_contact(scene0, y, 0)
         dy = np.zeros(13)
         dy[0:3] = y[7:10]
         dy[3:7] = 0.5 * qt.multiply(np.r_[0.0, y[10:13]], y[3:7])
@@ -85,7 +94,7 @@ def test_lift_off_time_is_where_the_force_crosses_zero():
         return dy
 
     def force(_t, y):
-        return newton_euler_single_contact(model, y, 0)[6]
+        return newton_euler_single_contact(scene0, y, 0)[6]
 
     force.terminal = True
     force.direction = -1
@@ -95,16 +104,16 @@ def test_lift_off_time_is_where_the_force_crosses_zero():
 
 
 def test_contact_phase_keeps_energy_and_constraints():
-    model = BodyModel.from_scene(make_scene(n=3, gamma=0.0))
-    y0 = rocking_state(model, wy=1.0)
-    traj = simulate(make_scene(n=3, gamma=0.0, state=y0, t_end=0.4))
+    y0 = rocking_state(wy=1.0)
+    scene = make_scene(n=3, gamma=0.0, state=y0, t_end=0.4)
+    traj = simulate(scene)
     assert traj.phases[0].kind == "contact"
     E = traj.energy
     assert np.max(np.abs(E - E[0])) < 1e-11 * E[0]
     # the held vertex stays on the ground: gap from the samples, recomputed here
     for i in range(0, traj.n_samples, 50):
         y = np.r_[traj.position[i], traj.quaternion[i], traj.velocity[i], traj.angular_velocity[i]]
-        g = model.contacts(y)[0][0]
+        g = scene_contact_kinematics(scene, y)[0][0, 0]
         assert abs(g) < 1e-12  # dense-output samples inside chunks; chunk ends are projected
 
 

@@ -1,11 +1,11 @@
-"""ImpactLog and SampleBuffer: the array-backed stores behave like the lists they replace."""
+"""ImpactLog and PhaseLog: the array-backed stores read like the lists they replace."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from reference.trajectory import ImpactEvent, ImpactLog, SampleBuffer
+from reference.trajectory import ImpactEvent, ImpactLog, Phase, PhaseLog
 
 
 def _events(k: int) -> list[ImpactEvent]:
@@ -39,19 +39,14 @@ def test_impact_log_reads_back_the_events_appended_one_by_one_and_in_blocks():
         log[600]
 
 
-def test_sample_buffer_keeps_rows_in_order_across_single_and_block_appends():
-    buf = SampleBuffer(capacity=4)
-    y = np.arange(13.0)
-    buf.add(0.0, 1e-20, y, 1.0, 2.0)
-    k = 10
-    t = np.column_stack([np.arange(1, k + 1, dtype=float), np.zeros(k)])
-    Y = np.tile(y, (k, 1)) + np.arange(1, k + 1)[:, None]
-    E = np.column_stack([np.ones(k), np.full(k, 2.0)])
-    buf.extend(t, Y, E)
-    buf.add(11.0, 0.0, y + 11, 1.0, 2.0)
-    a = buf.arrays()
-    assert len(buf) == 12
-    np.testing.assert_array_equal(a["t"], np.arange(12.0))
-    assert a["t_lo"][0] == 1e-20
-    np.testing.assert_array_equal(a["states"][:, 0], np.arange(12.0))
-    np.testing.assert_array_equal(a["states"][:, 12], 12.0 + np.arange(12.0))
+def test_impact_log_from_rows_equals_the_events():
+    ev = _events(5)
+    rows = [[e.t, e.t_lo, e.contact, e.impulse, e.v_normal_pre, e.v_normal_post] for e in ev]
+    assert list(ImpactLog.from_rows(np.array(rows))) == ev
+
+
+def test_phase_log_reads_rows_as_phases():
+    rows = np.array([[0.0, 0.5, 0, -1, -1, -1], [0.5, 0.75, 1, 2, 4, -1]])
+    log = PhaseLog(rows)
+    assert list(log) == [Phase(0.0, 0.5, "flight", ()), Phase(0.5, 0.75, "contact", (2, 4))]
+    assert log[-1].contacts == (2, 4) and len(log) == 2 and log[:1] == [log[0]]

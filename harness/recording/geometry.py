@@ -1,7 +1,7 @@
 """What a recording draws in 3D, as plain arrays: the body's outline, the ground, and the
 world positions of the contact points at every sample (vectorised over samples).
 
-Conventions are the reference's (reference/body.py, DESIGN.md §2): quaternions (w, x, y, z)
+Conventions are the reference's (reference.geometry): quaternions (w, x, y, z)
 body → world; `flat` ground is z = 0 with contact k at vertex k,
 r_k = a (cos 2πk/n, sin 2πk/n, 0); `three_point` ground has bump k at
 b_k = b (cos 2πk/3, sin 2πk/3, 0) touching the body's face (normal e3 = R ẑ).
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.body import BodyModel
+from reference.geometry import contact_points as scene_points
 from reference.scene import Scene
 
 
@@ -82,15 +82,15 @@ def contact_points(
 
     flat: the vertices, p_k = x + R r_k, gap_k = (p_k)_z.
     three_point: the point of the face above bump k, p_k = b_k + gap_k e3 with
-    gap_k = (x − b_k)·e3 (reference/body.py)."""
-    model = BodyModel.from_scene(scene)
+    gap_k = (x − b_k)·e3 (reference.geometry)."""
+    points = scene_points(scene.body, scene.ground)
     x = np.asarray(position, dtype=float)
     R = rotation_matrices(quaternion_wxyz)
-    if model.flat:
-        pts = x[:, None, :] + np.matmul(R, model.points.T).transpose(0, 2, 1)
+    if scene.ground.kind == "flat":
+        pts = x[:, None, :] + np.matmul(R, points.T).transpose(0, 2, 1)
         return pts, pts[:, :, 2].copy()
     e3 = R[:, :, 2]
-    d = x[:, None, :] - model.points[None, :, :]
+    d = x[:, None, :] - points[None, :, :]
     gap = np.matmul(d, e3[:, :, None])[:, :, 0]
-    pts = model.points[None, :, :] + gap[:, :, None] * e3[:, None, :]
+    pts = points[None, :, :] + gap[:, :, None] * e3[:, None, :]
     return pts, gap

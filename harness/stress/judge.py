@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 
 from engines.base import contact_kinematics
-from reference.body import BodyModel, initial_state
+from reference.geometry import initial_state
+from reference.geometry import length_scale as state_length_scale
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
@@ -88,8 +89,7 @@ def max_penetration(run: Trajectory, scene: Scene) -> float | None:
 def length_scale(scene: Scene) -> float:
     """Height of the centre plus the rim's vertical extent at t = 0 (the case's length
     unit for penetration), the radius if that is 0."""
-    y0 = initial_state(scene)
-    L = BodyModel.from_scene(scene).length_scale(y0)
+    L = float(state_length_scale(scene, initial_state(scene.initial))[0])
     return L if L > 0 else scene.body.radius
 
 

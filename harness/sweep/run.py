@@ -54,28 +54,24 @@ def pre_impact_samples(traj) -> np.ndarray:
 
 def excess_energy_at(traj, scene):
     """energy_at(indices) for `trajectory_exponent`: the energy above the floor that the
-    invariants allow (reference.simulate.excess_energy; on flat ground
+    invariants allow (reference.geometry.excess_energy; on flat ground
     E − ½ m |v_h|² − L_z²/(2 I3)).  The motion ends with that floor, not zero: the
     horizontal momentum and L_z are conserved, and L_z ≠ 0 for a tilted spinning body,
     so fitting the total energy would flatten the tail of the power law."""
-    from reference.body import BodyModel
-    from reference.simulate import excess_energy
-
-    model = BodyModel.from_scene(scene)
+    from reference.geometry import excess_energy
 
     def energy_at(idx: np.ndarray) -> np.ndarray:
-        out = np.empty(len(idx))
-        for k, i in enumerate(idx):
-            y = np.concatenate(
-                [
-                    traj.position[i],
-                    traj.quaternion[i],
-                    traj.velocity[i],
-                    traj.angular_velocity[i],
-                ]
-            )
-            out[k] = excess_energy(model, y)
-        return out
+        idx = np.asarray(idx, dtype=int)
+        states = np.concatenate(
+            [
+                traj.position[idx],
+                traj.quaternion[idx],
+                traj.velocity[idx],
+                traj.angular_velocity[idx],
+            ],
+            axis=1,
+        )
+        return excess_energy(scene, states)
 
     return energy_at
 

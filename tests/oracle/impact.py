@@ -1,4 +1,4 @@
-"""Single-point Newtonian impacts (paper §2.3, eqs. utk1–utk3, F, ω⁺, v⁺).
+"""Oracle: single-point Newtonian impacts (paper §2.3, eqs. utk1–utk3, F, ω⁺, v⁺).
 
 An impulse ζ n at lever r changes (v, ω) by M⁻¹ Jᵀ ζ with J = [nᵀ, (r × n)ᵀ]; the
 Newtonian law u⁺ = −γ u⁻ for the contact's normal velocity u = J (v, ω) gives
@@ -16,7 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import body as body_mod
 from .body import BodyModel, Q, V, W
 
 
@@ -39,18 +38,6 @@ def impact_impulse(
     (all contacts when None; NaN for the unwatched), so a caller that needs only the
     resting ones does not pay for every vertex of a large polygon."""
     idx = np.arange(model.n_contacts) if watch is None else np.array([k, *watch], dtype=int)
-    if model.flat and body_mod.COMPILED_KINEMATICS:
-        from .contact_kernel import impact_flat
-
-        if watch is None:  # the hitting vertex first
-            idx = np.concatenate(([k], np.delete(idx, k)))
-        y_post = np.array(y, dtype=float)
-        vn_idx = np.empty(len(idx))
-        zeta, u_pre = impact_flat(y_post, model.points[idx], model.mass, model.i1, model.i3,
-                                  float(gamma), vn_idx)  # fmt: skip
-        vn_post = np.full(model.n_contacts, np.nan)
-        vn_post[idx] = vn_idx
-        return ImpactResult(y_post, float(zeta), float(u_pre), float(vn_idx[0]), vn_post)
     gap, normal, lever, vn, _ = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])
@@ -78,14 +65,6 @@ def apply_normal_impulses(
     momentum and vertical angular momentum are untouched on flat ground."""
     if not contacts:
         return y
-    if model.flat and body_mod.COMPILED_KINEMATICS and len(contacts) <= 2:
-        from .contact_kernel import normal_impulses
-
-        out = np.array(y, dtype=float)
-        held = np.ascontiguousarray(model.points[list(contacts)])
-        normal_impulses(out, held, model.mass, model.i1, model.i3,
-                        np.asarray(target_vn, dtype=float))  # fmt: skip
-        return out
     gap, normal, lever, vn, _ = model.contacts(y, np.asarray(contacts, dtype=int))
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])

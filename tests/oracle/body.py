@@ -1,4 +1,4 @@
-"""Rigid-body model of a scene: mass, inertia, contact geometry, energy, invariants.
+"""Oracle: rigid-body model of a scene in numpy (mass, inertia, contact geometry, energy).
 
 State vector (13): position x (3), quaternion q = (w, x, y, z) body → world (4),
 velocity v (3), angular velocity ω in the world frame (3).
@@ -21,20 +21,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reference.geometry import contact_points
+from reference.geometry import initial_state as geometry_initial_state
+from reference.scene import Scene
+
 from . import quaternion as qt
-from .geometry import contact_points
-from .geometry import initial_state as geometry_initial_state
-from .scene import Scene
 
 EPS = np.finfo(float).eps
 
 X, Q, V, W = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
-
-# near_ground lists every vertex of polygons up to this size (the arc is not worth it)
-NEAR_GROUND_ALL = 64
-# flat-ground contact kinematics from the compiled loops of reference.body_kernel (the
-# array expressions below stay as their specification)
-COMPILED_KINEMATICS = True
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -91,15 +86,6 @@ class BodyModel:
         is the roundoff level of the gap (a few ulps of the terms that form it)."""
         x, q, v, w = y[X], y[Q], y[V], y[W]
         pts = self.points if idx is None else self.points[idx]
-        if self.flat and COMPILED_KINEMATICS:
-            from .body_kernel import contacts_flat
-
-            k = len(pts)
-            gap, lever, vn, noise = np.empty(k), np.empty((k, 3)), np.empty(k), np.empty(k)
-            contacts_flat(np.asarray(y, dtype=float), pts, gap, lever, vn, noise)
-            normal = np.zeros((k, 3))
-            normal[:, 2] = 1.0
-            return gap, normal, lever, vn, noise
         if self.flat:
             R = qt.to_matrix(q)
             # z-row computed from the small quaternion terms directly
@@ -121,32 +107,6 @@ class BodyModel:
             vn = v @ e3 + cross(w[None, :], lever) @ e3
             noise = 8 * EPS * (np.abs(d) @ np.abs(e3))
         return gap, normal, lever, vn, noise
-
-    def near_ground(self, y: np.ndarray, height: float) -> np.ndarray:
-        """Indices of the contacts whose gap can be ≤ `height` at state y: every contact
-        for three_point ground or n ≤ NEAR_GROUND_ALL, else an arc of vertices.
-
-        A vertex's gap is z + a c_k·u with c_k = (cos θ_k, sin θ_k) and u = (R20, R21)
-        (|u| = sin α): gap_k ≤ h ⟺ cos(θ_k − ψ) ≥ (z − h) / (a |u|), ψ the direction
-        of −u, an arc of half-width acos((z − h) / (a |u|)) around ψ, widened by two
-        vertices against roundoff."""
-        n = self.n_contacts
-        if not self.flat or n <= NEAR_GROUND_ALL:
-            return np.arange(n)
-        wq, xq, yq, zq = y[Q]
-        ux, uy = 2 * (xq * zq - wq * yq), 2 * (yq * zq + wq * xq)
-        aU = self.radius * math.hypot(ux, uy)
-        c = (float(y[2]) - height) / aU if aU > 0 else (math.inf if y[2] > height else -math.inf)
-        if c > 1.0 + 1e-12:
-            return np.zeros(0, dtype=int)
-        if c <= -1.0:
-            return np.arange(n)
-        dth = 2 * math.pi / n
-        half = math.ceil(math.acos(min(c, 1.0)) / dth) + 2
-        if 2 * half + 1 >= n:
-            return np.arange(n)
-        k0 = round(math.atan2(-uy, -ux) / dth)
-        return (k0 + np.arange(-half, half + 1)) % n
 
     def jacobian(self, normal: np.ndarray, lever: np.ndarray) -> np.ndarray:
         """Rows J_k = [n_kᵀ, (r_k × n_k)ᵀ] mapping (v, ω) to normal velocities

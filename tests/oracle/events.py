@@ -1,4 +1,4 @@
-"""Event location that never misses a root (DESIGN.md §2 "Events").
+"""Oracle: event location that never misses a root (DESIGN.md §2 "Events").
 
 Each contact's gap g(s) is smooth.  From its value, first and second derivative at the
 current time and bounds on its second and third derivatives over the search horizon, two
@@ -21,7 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import body as body_mod
 from .body import BodyModel, V, X
 from .flight import FlightConstants, flight_acceleration, free_flight
 
@@ -39,19 +38,7 @@ class GapJet:
 
 def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray, idx=None) -> GapJet:
     """g, g′ = J u, g″ = J [v̇; ω̇] + bias for the contacts `idx` (every contact by
-    default), at state y with accelerations acc6.  Over flat ground the compiled loop
-    (reference.flight_kernel.gap_jet_flat) evaluates the same expressions."""
-    if model.flat and body_mod.COMPILED_KINEMATICS:
-        from .flight_kernel import gap_jet_flat
-
-        pts = model.points if idx is None else np.ascontiguousarray(model.points[idx])
-        n = len(pts)
-        gap, vn, accel, noise = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-        gap_jet_flat(
-            np.asarray(y, dtype=float), pts, np.asarray(acc6, dtype=float), gap, vn, accel, noise
-        )
-        rn = np.full_like(vn, 64 * np.finfo(float).eps * model.velocity_scale(y))
-        return GapJet(gap, vn, accel, noise, rn)
+    default), at state y with accelerations acc6."""
     gap, normal, lever, vn, noise = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
     accel = J @ acc6 + model.bias(y, normal, lever, idx)
@@ -181,24 +168,17 @@ class FlightEvent:
     kind: str = "impact"  # or "activation": touching at rest and pressing in (no impact)
 
 
-USE_KERNEL = True  # compiled search for flat ground (reference.flight_kernel)
-
-
 def next_flight_event(
     model: BodyModel,
     fc: FlightConstants,
     horizon: float,
     max_iter: int = 100_000,
-    compiled: bool | None = None,
 ) -> FlightEvent | None:
     """First contact reached (approaching) within `horizon` of free flight, or None.
 
     Contacts currently touching but separating (g ≈ 0, g′ > 0, just after an impact)
-    are not events; the lower bounds carry the search past them.  On flat ground the
-    compiled kernel runs the same search unless `compiled` is False."""
+    are not events; the lower bounds carry the search past them."""
     K, B = flight_bounds(model, fc, horizon)
-    if model.flat and (USE_KERNEL if compiled is None else compiled):
-        return _next_flight_event_compiled(model, fc, horizon, max_iter, K, B)
     s = 0.0
     y = fc.y0
     for it in range(max_iter):
@@ -229,43 +209,6 @@ def next_flight_event(
         s += step
         y = free_flight(fc, s)
     raise RuntimeError("event search did not converge (max_iter)")
-
-
-def _next_flight_event_compiled(model, fc, horizon, max_iter, K, B) -> FlightEvent | None:
-    from .flight_kernel import search_flat
-
-    out = np.empty(13)
-    vscale = model.velocity_scale(fc.y0)
-    s, k, it, n_sim, k2, kind = search_flat(
-        fc.y0,
-        fc.L_over_A,
-        fc.lam,
-        fc.gravity,
-        model.points,
-        model.radius,
-        K,
-        B,
-        vscale,
-        horizon,
-        max_iter,
-        out,
-    )
-    if k == -2:
-        raise RuntimeError("event search did not converge (max_iter)")
-    if k < 0:
-        return None
-    if kind == 1:
-        return FlightEvent(s, (int(k),), out, int(it), kind="activation")
-    if n_sim > 1:
-        # name every contact reached together (rare path: recompute in Python)
-        jet = gap_jet(model, out, flight_acceleration(fc, out))
-        t_res = (jet.noise + 1e-300) / np.maximum(-jet.rate, 1e-300)
-        close = (jet.rate < -jet.rate_noise) & (
-            jet.gap / np.maximum(-jet.rate, 1e-300) <= 4.0 * (t_res + t_res[k])
-        )
-        together = sorted(set(np.flatnonzero(close).tolist()) | {int(k)})
-        return FlightEvent(s, tuple(together), out, int(it))
-    return FlightEvent(s, (int(k),), out, int(it))
 
 
 def _polish(model, fc, s, jet: GapJet, hit: np.ndarray, horizon: float, it: int) -> FlightEvent:

@@ -1,4 +1,4 @@
-"""Sustained contact (paper §2.2, eqs. rollF, rollM, rollc; DESIGN.md §2).
+"""Oracle: sustained contact (paper §2.2, eqs. rollF, rollM, rollc; DESIGN.md §2).
 
 With a set C of contacts held (gap 0, normal velocity 0), the normal accelerations are
 a_n = A λ + b with A = J M⁻¹ Jᵀ and b = J M⁻¹ f + bias (gravity, gyroscopic term and
@@ -18,7 +18,6 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import body as body_mod
 from . import quaternion as qt
 from .body import BodyModel, Q, V, W, X
 
@@ -26,17 +25,6 @@ from .body import BodyModel, Q, V, W, X
 def contact_system(model: BodyModel, y: np.ndarray, contacts: list[int]):
     """(A, b, J, Minv, acc_free) for the contacts held, at state y."""
     idx = np.asarray(contacts, dtype=int)
-    if model.flat and body_mod.COMPILED_KINEMATICS:
-        from .body_kernel import contact_system_flat
-
-        m = len(idx)
-        A, b, J = np.empty((m, m)), np.empty(m), np.empty((m, 6))
-        Minv, acc_free = np.empty((6, 6)), np.empty(6)
-        contact_system_flat(
-            np.asarray(y, dtype=float), model.points[idx], model.mass, model.i1, model.i3,
-            model.gravity, A, b, J, Minv, acc_free,
-        )  # fmt: skip
-        return A, b, J, Minv, acc_free
     gap, normal, lever, vn, _ = model.contacts(y, idx)
     J = model.jacobian(normal, lever)
     Minv = model.mass_matrix_inv(y[Q])
@@ -124,23 +112,9 @@ def _lcp_small(candidates: list[int], A: np.ndarray, b: np.ndarray, tol: float):
     raise RuntimeError("contact complementarity problem has no solution")
 
 
-def constrained_rhs(model: BodyModel, contacts: list[int], compiled: bool = True):
+def constrained_rhs(model: BodyModel, contacts: list[int]):
     """dy/dt with the contacts held as bilateral constraints (forces may go negative:
-    that is the lift-off signal).  Flat ground with one or two contacts uses the
-    compiled closed form (reference.contact_kernel.held_rhs)."""
-    if compiled and model.flat and 1 <= len(contacts) <= 2:
-        from .contact_kernel import held_rhs
-
-        held = np.ascontiguousarray(model.points[list(contacts)])
-        m, i1, i3, g = model.mass, model.i1, model.i3, model.gravity
-        lam = np.empty(2)
-
-        def rhs_fast(_t: float, y: np.ndarray) -> np.ndarray:
-            dy = np.empty(13)
-            held_rhs(y, held, m, i1, i3, g, dy, lam)
-            return dy
-
-        return rhs_fast
+    that is the lift-off signal)."""
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
         A, b, J, Minv, acc_free = contact_system(model, y, contacts)
@@ -226,13 +200,16 @@ def chunk_horizon(model: BodyModel, y: np.ndarray, jet, held: np.ndarray) -> flo
     ground (quadratic lower bound with K = 2 max(|g″|) + g over them, a factor-2 margin
     on the current second derivatives), and the chunk stays short against the local
     time scale √(length / acceleration)."""
-    from .flight_kernel import min_safe_step
+    from .events import first_root_lower_bound
 
     g = model.gravity
     free = ~held
     acc_scale = float(np.max(np.abs(jet.accel[free]))) if free.any() else 0.0
     K = 2.0 * acc_scale + g + 1e-300
-    h = min_safe_step(jet.gap, jet.rate, jet.accel, jet.noise, held, K, 0.0)
+    h = math.inf
+    for k in np.flatnonzero(free):
+        g_k = max(float(jet.gap[k]), float(jet.noise[k]))
+        h = min(h, first_root_lower_bound(g_k, float(jet.rate[k]), float(jet.accel[k]), K, 0.0))
     L = model.length_scale(y)
     T_local = math.sqrt(max(L, 1e-300) / K)
     vs = model.velocity_scale(y)

@@ -1,0 +1,157 @@
+"""Access to the compiled event loop: ahead-of-time when it has been built, else numba's
+just-in-time compilation with its on-disk cache.
+
+`make setup` builds the loop ahead of time (`python -m reference.core.aot`, a C
+compiler needed) into an extension module beside the sources; it imports in
+milliseconds and needs no numba at run time.  A stamp of the core's source files is
+stored with it: when the sources change, the stale module is ignored and the loop is
+compiled just in time (cached in __pycache__ after the first run).  `warm_up` does the
+one-time work (compilation, or loading the cache) apart, so that run times never
+include it, and says so on stderr the first time it compiles."""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import os
+import sys
+import time
+from pathlib import Path
+
+CORE_DIR = Path(__file__).with_name("core")
+AOT_MODULE = "reference.core._aot"
+STAMP_FILE = CORE_DIR / "_aot.stamp"
+# A rough cost of compiling the loop just in time on a 2-core machine (measured).
+JIT_COMPILE_ESTIMATE_S = 60
+
+# exported function → the core module that defines it
+EXPORTS = {
+    "run_events": "loop",
+    "quaternion_product_rows": "arrays",
+    "quaternion_exp_rows": "arrays",
+    "quaternion_log_rows": "arrays",
+    "rotate_rows": "arrays",
+    "tilt_rows": "arrays",
+    "axis_rows": "arrays",
+    "contact_kinematics_rows": "arrays",
+    "energy_rows": "arrays",
+    "free_acceleration_rows": "arrays",
+    "length_scale_rows": "arrays",
+}
+
+_aot = None
+_aot_checked = False
+_cache_checked = False
+_warm = False
+
+
+def source_stamp() -> str:
+    """SHA-256 of the core's source files (what the ahead-of-time module was built from)."""
+    h = hashlib.sha256()
+    for path in sorted(CORE_DIR.glob("*.py")):
+        h.update(path.name.encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def _load_aot():
+    """The ahead-of-time module if it exists and matches the sources (None when the
+    environment variable EULER_DISK_NO_AOT is set)."""
+    if os.environ.get("EULER_DISK_NO_AOT"):
+        return None
+    try:
+        stamp = STAMP_FILE.read_text().strip()
+    except OSError:
+        return None
+    if stamp != source_stamp():
+        return None
+    try:
+        return importlib.import_module(AOT_MODULE)
+    except ImportError:
+        return None
+
+
+def _clear_stale_jit_cache() -> None:
+    """numba's cache does not notice that a function called from another module has
+    changed; after any change to the core's sources its cached machine code is dropped
+    (the stamp of the sources it was compiled from is kept beside it)."""
+    global _cache_checked
+    if _cache_checked:
+        return
+    _cache_checked = True
+    cache = CORE_DIR / "__pycache__"
+    stamp_file = cache / "jit.stamp"
+    stamp = source_stamp()
+    try:
+        if stamp_file.read_text().strip() == stamp:
+            return
+    except OSError:
+        pass
+    for path in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
+        path.unlink(missing_ok=True)
+    try:
+        cache.mkdir(exist_ok=True)
+        stamp_file.write_text(stamp + "\n")
+    except OSError:
+        pass
+
+
+def _aot_module():
+    global _aot, _aot_checked
+    if not _aot_checked:
+        _aot, _aot_checked = _load_aot(), True
+    return _aot
+
+
+def jit_function(name: str):
+    """The just-in-time (numba) version of an exported function."""
+    _clear_stale_jit_cache()
+    module = importlib.import_module(f"reference.core.{EXPORTS[name]}")
+    return getattr(module, name)
+
+
+def function(name: str):
+    """A compiled function of the core (EXPORTS): ahead-of-time if built and fresh,
+    else just in time."""
+    aot = _aot_module()
+    if aot is not None:
+        return getattr(aot, name)
+    return jit_function(name)
+
+
+def run_events():
+    """The compiled event loop (reference.core.loop.run_events)."""
+    return function("run_events")
+
+
+def kernel_source() -> str:
+    """'ahead-of-time' or 'just-in-time'."""
+    return "ahead-of-time" if _aot_module() is not None else "just-in-time"
+
+
+def _jit_cached() -> bool:
+    """Whether numba's cache holds the loop already (its index file exists)."""
+    return any((CORE_DIR / "__pycache__").glob("loop.run_events-*.nbi"))
+
+
+def warm_up() -> float:
+    """Compile or load the event loop once per process (a tiny run); returns the seconds
+    it took (0 when already warm).  The first compilation on a machine is announced on
+    stderr with its rough duration."""
+    global _warm
+    if _warm:
+        return 0.0
+    t0 = time.perf_counter()
+    kernel = run_events()
+    if kernel_source() == "just-in-time" and not _jit_cached():
+        print(
+            f"reference: compiling the event loop (first run on this machine, about "
+            f"{JIT_COMPILE_ESTIMATE_S} s; `make setup` builds it ahead of time)",
+            file=sys.stderr,
+            flush=True,
+        )
+    from .simulate import tiny_run
+
+    tiny_run(kernel)
+    _warm = True
+    return time.perf_counter() - t0

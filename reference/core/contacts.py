@@ -1,0 +1,142 @@
+"""Contact geometry for one state (the model of Baranyai & Várkonyi, section 2):
+
+- flat ground: contact k is vertex k at body position p_k = a(cos 2πk/n, sin 2πk/n, 0);
+  lever r = R p_k, gap g = z + r_z, normal n = e_z (paper eq. rig, exact in α);
+- three-point ground: contact k is the bump b_k = b(cos 2πk/3, sin 2πk/3, 0) under the
+  body's face (normal e3 = R ẑ through the centre of mass): with d = x − b_k, gap
+  g = d·e3, normal n = e3, lever r = −d + g e3 (the in-plane part of b_k − x).
+
+Either way the normal velocity is g′ = n·(v + ω × r) and the normal acceleration is
+g″ = J (v̇, ω̇) + bias with J = [nᵀ, (r × n)ᵀ] (paper eq. rollc).  `pts` holds the
+body-frame vertices (flat) or the world bumps (three-point).  Accelerations `acc` are
+tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
+
+import math
+
+from numba import njit
+
+from .records import Frame, Jet
+from .rotation import body_axis, rotation_columns_xy
+from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
+
+
+@njit(cache=True)
+def vertex_lever(y, px, py):
+    """r = R p of the body point p = (px, py, 0): its position from the centre of mass in
+    the world frame (r_z from the small quaternion components: tilts keep their digits)."""
+    R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y)
+    return R00 * px + R01 * py, R10 * px + R11 * py, R20 * px + R21 * py
+
+
+@njit(cache=True)
+def vertex_frame(y, px, py):
+    """Frame of the body point (px, py, 0) over flat ground: gap z + r_z, normal e_z,
+    lever r, roundoff GAP_NOISE_ULPS ε (|z| + |r_z|)."""
+    rx, ry, rz = vertex_lever(y, px, py)
+    noise = GAP_NOISE_ULPS * EPS * (abs(y[2]) + abs(rz))
+    return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, noise)
+
+
+@njit(cache=True)
+def bump_frame(y, bx, by, bz):
+    """Frame of the ground bump b under the body's face: gap d·e3 (d = x − b), normal e3,
+    lever −d + gap e3, roundoff GAP_NOISE_ULPS ε Σ|d_j e3_j|."""
+    ex, ey, ez = body_axis(y)
+    dx, dy, dz = y[0] - bx, y[1] - by, y[2] - bz
+    gap = dx * ex + dy * ey + dz * ez
+    noise = GAP_NOISE_ULPS * EPS * (abs(dx * ex) + abs(dy * ey) + abs(dz * ez))
+    return Frame(gap, ex, ey, ez, -dx + gap * ex, -dy + gap * ey, -dz + gap * ez, noise)
+
+
+@njit(cache=True)
+def contact_frame(y, flat, pts, k):
+    """Gap, normal, lever and gap roundoff of contact k at state y."""
+    if flat:
+        return vertex_frame(y, pts[k, 0], pts[k, 1])
+    return bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
+
+
+@njit(cache=True)
+def normal_velocity(y, f, flat):
+    """g′ = n·(v + ω × r) of the contact with frame f (flat ground: v_z + (ω × r)_z)."""
+    wx, wy, wz = y[10], y[11], y[12]
+    if flat:
+        return y[9] + (wx * f.ry - wy * f.rx)
+    cx = wy * f.rz - wz * f.ry
+    cy = wz * f.rx - wx * f.rz
+    cz = wx * f.ry - wy * f.rx
+    return f.nx * (y[7] + cx) + f.ny * (y[8] + cy) + f.nz * (y[9] + cz)
+
+
+@njit(cache=True)
+def vertex_normal_acceleration(y, f, acc):
+    """g″ = v̇_z + (ω̇ × r)_z + (ω × (ω × r))_z of a vertex over flat ground, with
+    (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z."""
+    wx, wy, wz = y[10], y[11], y[12]
+    return (
+        acc[2]
+        + (acc[3] * f.ry - acc[4] * f.rx)
+        + (wx * f.rx + wy * f.ry + wz * f.rz) * wz
+        - (wx * wx + wy * wy + wz * wz) * f.rz
+    )
+
+
+@njit(cache=True)
+def bump_normal_acceleration(y, f, acc, bx, by, bz):
+    """g″ = n·v̇ + (r × n)·ω̇ + 2 v·(ω × e3) + d·(ω × (ω × e3)) of a bump, d = x − b."""
+    wx, wy, wz = y[10], y[11], y[12]
+    nx, ny, nz = f.nx, f.ny, f.nz
+    cx, cy, cz = f.ry * nz - f.rz * ny, f.rz * nx - f.rx * nz, f.rx * ny - f.ry * nx
+    lin = nx * acc[0] + ny * acc[1] + nz * acc[2] + cx * acc[3] + cy * acc[4] + cz * acc[5]
+    ux, uy, uz = wy * nz - wz * ny, wz * nx - wx * nz, wx * ny - wy * nx  # ω × e3
+    vx, vy, vz = wy * uz - wz * uy, wz * ux - wx * uz, wx * uy - wy * ux  # ω × (ω × e3)
+    dx, dy, dz = y[0] - bx, y[1] - by, y[2] - bz
+    return lin + 2.0 * (y[7] * ux + y[8] * uy + y[9] * uz) + dx * vx + dy * vy + dz * vz
+
+
+@njit(cache=True)
+def normal_acceleration(y, f, acc, flat, pts, k):
+    """g″ of contact k (frame f) for accelerations acc."""
+    if flat:
+        return vertex_normal_acceleration(y, f, acc)
+    return bump_normal_acceleration(y, f, acc, pts[k, 0], pts[k, 1], pts[k, 2])
+
+
+@njit(cache=True)
+def point_jet(y, px, py, acc):
+    """Gap, rate, acceleration and roundoff of the body point (px, py, 0) over flat
+    ground."""
+    f = vertex_frame(y, px, py)
+    return Jet(f.gap, normal_velocity(y, f, True), vertex_normal_acceleration(y, f, acc), f.noise)
+
+
+@njit(cache=True)
+def contact_jet(y, flat, pts, k, acc):
+    """Gap, rate, acceleration and gap roundoff of contact k for accelerations acc."""
+    if flat:
+        return point_jet(y, pts[k, 0], pts[k, 1], acc)
+    f = contact_frame(y, flat, pts, k)
+    return Jet(
+        f.gap, normal_velocity(y, f, flat), normal_acceleration(y, f, acc, flat, pts, k), f.noise
+    )
+
+
+@njit(cache=True)
+def velocity_scale(y, radius):
+    """V = |v| + a|ω|: the largest speed of a rim point (the local velocity unit)."""
+    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + radius * math.sqrt(
+        y[10] ** 2 + y[11] ** 2 + y[12] ** 2
+    )
+
+
+@njit(cache=True)
+def rate_noise(y, radius):
+    """Roundoff level of a normal velocity: RATE_NOISE_ULPS ε V."""
+    return RATE_NOISE_ULPS * EPS * velocity_scale(y, radius)
+
+
+@njit(cache=True)
+def length_scale(y, radius):
+    """L = |z| + a sin α: the height of the centre plus the rim's vertical extent."""
+    ex, ey, _ = body_axis(y)
+    return abs(y[2]) + radius * math.sqrt(ex * ex + ey * ey)

@@ -1,0 +1,212 @@
+"""Instantaneous events of the loop: an impact (with the chatter completion and the
+contacts it leaves held), an activation (contacts landing at rest start to be held),
+and the start of the run.  Each returns False when it ended the run (state.status
+set), True otherwise."""
+
+import numpy as np
+from numba import njit
+
+from .chatter import accumulation_time, completion_speed
+from .contacts import contact_frame, contact_jet, normal_velocity, rate_noise, velocity_scale
+from .held import held_acceleration, solve_lcp, zero_normal_velocities
+from .impact import impact, pushed_contacts
+from .inertia import excess_energy
+from .output import push_accumulation, push_impact, push_sample
+from .records import (
+    STATUS_AT_REST,
+    STATUS_FAILED_LCP,
+    STATUS_PUSHED,
+    STATUS_SIMULTANEOUS,
+)
+
+
+@njit(cache=True)
+def end_run(state, status, contacts, n):
+    """Stop with `status` at the current time, naming contacts[:n]."""
+    state.status = status
+    state.info_t = state.t_hi
+    state.n_info = min(n, state.info.shape[0])
+    for i in range(state.n_info):
+        state.info[i] = contacts[i]
+
+
+@njit(cache=True)
+def hold(state, model, pts, ws, cand, m):
+    """Zero the normal velocities of cand[:m] and hold the contacts the LCP keeps.  More
+    than three candidates are the body lying down: all of them are held (the loop then
+    ends the motion)."""
+    if m == 0:
+        state.n_active = 0
+        return True
+    if m > 3:
+        state.n_active = m
+        for i in range(3):
+            state.active[i] = cand[i]
+        return True
+    if not zero_normal_velocities(state.y, model, pts, cand, m, ws.work):
+        end_run(state, STATUS_FAILED_LCP, cand, m)
+        return False
+    n = solve_lcp(state.y, model, pts, cand, m, ws.work, ws.active)
+    if n < 0:
+        end_run(state, STATUS_FAILED_LCP, cand, m)
+        return False
+    state.n_active = n
+    for i in range(n):
+        state.active[i] = ws.active[i]
+    return True
+
+
+@njit(cache=True)
+def _completes(state, model, pts, ws, k, m, u, vnoise):
+    """Whether contact k, separating at u ≤ the completion speed with cand[:m] held,
+    falls back (a_n < 0) or is at rest: then its chatter is completed."""
+    acc = held_acceleration(state.y, model, pts, ws.cand, m, ws.work)
+    a_n = contact_jet(state.y, model.flat_ground, pts, k, acc).accel
+    return a_n < 0 or u <= vnoise, a_n
+
+
+@njit(cache=True)
+def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, resting, n_rest):
+    """The impact of hitting[0] with resting[:n_rest] held (paper §2.3), then the
+    contacts to hold: resting ones left at rest or separating slower than the completion
+    speed, and the hit one if its chatter is completed."""
+    y = state.y
+    if n_hit > 1:
+        end_run(state, STATUS_SIMULTANEOUS, hitting, n_hit)
+        return False
+    k = hitting[0]
+    stats.max_penetration = max(
+        stats.max_penetration, -contact_frame(y, model.flat_ground, pts, k).gap
+    )
+    vnoise = rate_noise(y, model.radius)
+    ws.y_start[:] = y
+    out_imp = impact(y, model, pts, k)
+    n_pushed = pushed_contacts(y, model, pts, resting, n_rest, vnoise, ws.together)
+    if n_pushed > 0:
+        y[:] = ws.y_start
+        state.info_contact = k
+        end_run(state, STATUS_PUSHED, ws.together, n_pushed)
+        return False
+    push_impact(out, state.t_hi, state.t_lo, k, out_imp.impulse, out_imp.u_pre, out_imp.u_post)
+    small = completion_speed(y, model, pts, k, opts.chatter_tol, vnoise)
+    m = 0
+    vs = velocity_scale(y, model.radius)
+    for i in range(n_rest):
+        vn = normal_velocity(
+            y, contact_frame(y, model.flat_ground, pts, resting[i]), model.flat_ground
+        )
+        if vn <= small:
+            ws.cand[m] = resting[i]
+            m += 1
+            if vn > vnoise:
+                stats.max_completion_u_rel = max(stats.max_completion_u_rel, vn / vs)
+    u = out_imp.u_post
+    if u <= vnoise and model.gamma == 0.0:
+        ws.cand[m] = k
+        m += 1
+    elif u <= small:
+        completes, a_n = _completes(state, model, pts, ws, k, m, u, vnoise)
+        if completes:
+            stats.chatter_completions += 1
+            stats.max_completion_u_rel = max(stats.max_completion_u_rel, u / vs)
+            push_accumulation(out, accumulation_time(state.t_hi, u, a_n, model.gamma))
+            ws.cand[m] = k
+            m += 1
+    if not hold(state, model, pts, ws, ws.cand, m):
+        return False
+    push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    return True
+
+
+@njit(cache=True)
+def activate(state, model, pts, ws, stats, landing, n_land):
+    """Contacts landing at rest (touching, no approach speed, accelerating into the
+    ground) start to be held with the held ones: zero their normal velocities (roundoff
+    only) and solve the LCP over all of them; if it would keep only the ones already
+    held (a roundoff tie), hold them all: the contact phase's force check releases any
+    that pull."""
+    m = 0
+    for i in range(state.n_active):
+        ws.cand[m] = state.active[i]
+        m += 1
+    for i in range(n_land):
+        new = True
+        for j in range(m):
+            if ws.cand[j] == landing[i]:
+                new = False
+        if new and m < ws.cand.shape[0]:
+            ws.cand[m] = landing[i]
+            m += 1
+    np_sort_prefix(ws.cand, m)
+    n_held_before = state.n_active
+    before = state.active.copy()
+    stats.activations += 1
+    if not hold(state, model, pts, ws, ws.cand, m):
+        return False
+    if _same_set(state.active, state.n_active, before, n_held_before):
+        state.n_active = m
+        for i in range(m):
+            state.active[i] = ws.cand[i]
+    return True
+
+
+@njit(cache=True)
+def np_sort_prefix(a, m):
+    """Sort a[:m] in place (m ≤ 4)."""
+    for i in range(1, m):
+        j = i
+        while j > 0 and a[j - 1] > a[j]:
+            a[j - 1], a[j] = a[j], a[j - 1]
+            j -= 1
+
+
+@njit(cache=True)
+def _same_set(a, na, b, nb):
+    if na != nb:
+        return False
+    for i in range(na):
+        found = False
+        for j in range(nb):
+            if a[i] == b[j]:
+                found = True
+        if not found:
+            return False
+    return True
+
+
+@njit(cache=True)
+def start(state, model, pts, opts, stats, out, ws):
+    """The run's first step: sample the initial state, then resolve contacts touching at
+    t = 0 (hitting: an impact with the resting ones held; resting only: hold them).
+    A body with every contact resting is already at the end of its motion."""
+    y = state.y
+    state.excess0 = excess_energy(
+        y, model.flat_ground, model.mass, model.i1, model.i3, model.gravity
+    )
+    push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    vnoise = rate_noise(y, model.radius)
+    n_hit = n_rest = 0
+    hitting = np.empty(pts.shape[0], dtype=np.int64)
+    resting = np.empty(pts.shape[0], dtype=np.int64)
+    for k in range(pts.shape[0]):
+        f = contact_frame(y, model.flat_ground, pts, k)
+        if f.gap > f.noise:
+            continue
+        vn = normal_velocity(y, f, model.flat_ground)
+        if vn < -vnoise:
+            hitting[n_hit] = k
+            n_hit += 1
+        elif abs(vn) <= vnoise:
+            resting[n_rest] = k
+            n_rest += 1
+    state.started = True
+    if n_hit:
+        return resolve_impact(
+            state, model, pts, opts, stats, out, ws, hitting, n_hit, resting, n_rest
+        )
+    if n_rest >= model.all_down:
+        end_run(state, STATUS_AT_REST, resting, n_rest)
+        return False
+    for i in range(n_rest):
+        ws.cand[i] = resting[i]
+    return hold(state, model, pts, ws, ws.cand, n_rest)

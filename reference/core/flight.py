@@ -1,0 +1,137 @@
+"""Free flight in closed form (paper eqs. acc1free–acc2free) and the bounds on the gaps'
+derivatives that make the event search safe.
+
+The centre of mass follows a parabola, x(s) = x0 + v0 s − ½ g s² e_z.  The body is
+axisymmetric (I1 = I2 = A, I3 = C), so torque-free rotation is regular precession: L is
+constant, and
+
+    R(s) = Rot(L̂, Ω s) · R0 · Rot(ẑ, λ s),   Ω = |L|/A,  λ = (1/C − 1/A)(L·e3),
+    ω(s) = L/A + λ e3(s),   ω̇ = λ (L/A) × e3.
+"""
+
+import math
+
+from numba import njit
+
+from .records import Bounds, FlightConstants
+from .rotation import body_axis, qmul, rotation_columns_xy, rotation_vector_quaternion
+from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS
+
+
+@njit(cache=True)
+def flight_constants(y, i1, i3):
+    """L/A, λ, |ω| and Ω of the free flight starting at state y."""
+    e3x, e3y, e3z = body_axis(y)
+    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
+    lax = y[10] - w3 * e3x + (i3 / i1) * w3 * e3x
+    lay = y[11] - w3 * e3y + (i3 / i1) * w3 * e3y
+    laz = y[12] - w3 * e3z + (i3 / i1) * w3 * e3z
+    lam = (1.0 / i3 - 1.0 / i1) * i3 * w3
+    wabs = math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    return FlightConstants(lax, lay, laz, lam, wabs, math.sqrt(lax * lax + lay * lay + laz * laz))
+
+
+@njit(cache=True)
+def free_flight(y0, fc, gravity, s, out):
+    """The state after a free flight of duration s from y0, into `out` (closed form)."""
+    out[0] = y0[0] + y0[7] * s
+    out[1] = y0[1] + y0[8] * s
+    out[2] = y0[2] + y0[9] * s - 0.5 * gravity * s * s
+    out[7] = y0[7]
+    out[8] = y0[8]
+    out[9] = y0[9] - gravity * s
+    p0, p1, p2, p3 = rotation_vector_quaternion(fc.lax * s, fc.lay * s, fc.laz * s)
+    a = qmul(p0, p1, p2, p3, y0[3], y0[4], y0[5], y0[6])
+    half = 0.5 * fc.lam * s
+    b = qmul(a[0], a[1], a[2], a[3], math.cos(half), 0.0, 0.0, math.sin(half))
+    nrm = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3])
+    out[3], out[4], out[5], out[6] = b[0] / nrm, b[1] / nrm, b[2] / nrm, b[3] / nrm
+    e3x, e3y, e3z = body_axis(out)
+    out[10] = fc.lax + fc.lam * e3x
+    out[11] = fc.lay + fc.lam * e3y
+    out[12] = fc.laz + fc.lam * e3z
+
+
+@njit(cache=True)
+def flight_acceleration(fc, y, gravity):
+    """(v̇, ω̇) in flight: (0, 0, −g) and λ (L/A) × e3."""
+    e3x, e3y, e3z = body_axis(y)
+    lam = fc.lam
+    return (
+        0.0,
+        0.0,
+        -gravity,
+        lam * (fc.lay * e3z - fc.laz * e3y),
+        lam * (fc.laz * e3x - fc.lax * e3z),
+        lam * (fc.lax * e3y - fc.lay * e3x),
+    )
+
+
+@njit(cache=True)
+def _height_terms(fx, fy, fz, Lx, Ly, Lz):
+    """For a body axis f: (L̂·f) L̂_z, f_z − (L̂·f) L̂_z and (L̂ × f)_z, the constant, cosine
+    and sine parts of (Rot(L̂, θ) f)_z (Rodrigues)."""
+    lf = Lx * fx + Ly * fy + Lz * fz
+    return lf * Lz, fz - lf * Lz, Lx * fy - Ly * fx
+
+
+@njit(cache=True)
+def vertex_height_bounds(y0, fc, radius, gravity):
+    """(K, B) ≥ max over the flight and over every vertex of |g″| and |g‴|, flat ground.
+
+    A vertex at body angle θ has height z(s) + a (Rot(L̂, Ωs) w(s))_z with
+    w = cos φ f1 + sin φ f2, φ = θ + λs, f1, f2 = R0 ê1, R0 ê2.  With (α_i, β_i, γ_i)
+    the constant, cosine and sine parts of (Rot(L̂, Ωs) f_i)_z, the height's rotating
+    part is a sum of three sinusoids in s, of frequencies |λ|, |λ + Ω|, |λ − Ω| and
+    amplitudes a|(α1, α2)|, ½a|(β1 − γ2, γ1 + β2)|, ½a|(β1 + γ2, β2 − γ1)| whatever θ.
+    So |g″| ≤ g + Σ A_j ω_j² and |g‴| ≤ Σ A_j ω_j³ (z‴ = 0): bounds that shrink with the
+    tilt, where a(|ω|² + …) would not."""
+    om, lam = fc.omega, fc.lam
+    if om > 0.0:
+        Lx, Ly, Lz = fc.lax / om, fc.lay / om, fc.laz / om
+    else:
+        Lx, Ly, Lz = 0.0, 0.0, 1.0
+    R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y0)
+    a1, b1, g1 = _height_terms(R00, R10, R20, Lx, Ly, Lz)
+    a2, b2, g2 = _height_terms(R01, R11, R21, Lx, Ly, Lz)
+    amp0 = radius * math.sqrt(a1 * a1 + a2 * a2)
+    amp_p = 0.5 * radius * math.sqrt((b1 - g2) ** 2 + (g1 + b2) ** 2)
+    amp_m = 0.5 * radius * math.sqrt((b1 + g2) ** 2 + (b2 - g1) ** 2)
+    w0, wp, wm = abs(lam), abs(lam + om), abs(lam - om)
+    K = gravity + amp0 * w0**2 + amp_p * wp**2 + amp_m * wm**2
+    B = amp0 * w0**3 + amp_p * wp**3 + amp_m * wm**3
+    slack = BOUND_ULPS * EPS * radius
+    return Bounds(
+        BOUND_MARGIN * K + slack * (w0**2 + wp**2 + wm**2),
+        BOUND_MARGIN * B + slack * (w0**3 + wp**3 + wm**3),
+    )
+
+
+@njit(cache=True)
+def bump_gap_bounds(y0, fc, pts, gravity, horizon):
+    """(K, B) for the three-point ground over a flight of `horizon`: with g = (x − b)·e3
+    and e3 precessing at Ω about L,
+        g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴,
+    |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2."""
+    H = horizon if math.isfinite(horizon) else 1e300
+    v0 = math.sqrt(y0[7] ** 2 + y0[8] ** 2 + y0[9] ** 2)
+    V = v0 + gravity * H
+    D = 0.0
+    for k in range(pts.shape[0]):
+        d = math.sqrt(
+            (y0[0] - pts[k, 0]) ** 2 + (y0[1] - pts[k, 1]) ** 2 + (y0[2] - pts[k, 2]) ** 2
+        )
+        D = max(D, d)
+    D += v0 * H + 0.5 * gravity * H * H
+    om = fc.omega
+    K = gravity + 2 * V * om + D * om * om
+    B = 3 * gravity * om + 3 * V * om * om + D * om**3
+    return Bounds(BOUND_MARGIN * K, BOUND_MARGIN * B)
+
+
+@njit(cache=True)
+def flight_bounds(y0, fc, model, pts, horizon):
+    """(K, B) for the scene's ground (`vertex_height_bounds` or `bump_gap_bounds`)."""
+    if model.flat_ground:
+        return vertex_height_bounds(y0, fc, model.radius, model.gravity)
+    return bump_gap_bounds(y0, fc, pts, model.gravity, horizon)

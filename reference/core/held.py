@@ -1,0 +1,228 @@
+"""Sustained contact (paper §2.2, eqs. rollF, rollM, rollc): contacts held at zero gap
+and zero normal velocity.
+
+With the set S held, the normal accelerations are a_n = A λ + b with A = J M⁻¹ Jᵀ and
+b = J a_free + bias (`contact_system`); held contacts need a_n = 0 (`held_forces`,
+`held_rhs`).  Which contacts to hold solves the acceleration-level complementarity
+problem λ ≥ 0, a_n ≥ 0, λ·a_n = 0, exactly, by enumerating the active sets
+(`solve_lcp`).  After each integrated chunk the state is projected back onto the
+constraints (`project_held`): positions by Gauss–Newton steps in the mass metric,
+velocities by normal impulses (`zero_normal_velocities`), so the constraints never
+drift.  Impulses act along the normals: on flat ground horizontal momentum and the
+vertical angular momentum are untouched."""
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from .contacts import contact_frame, normal_acceleration, normal_velocity
+from .inertia import apply_impulse, free_acceleration, impulse_response
+from .linalg import solve_small
+from .records import Response
+from .rotation import quaternion_rate, rotate_attitude
+from .tolerances import PROJECTION_PASSES
+
+# Work arrays for up to three contacts: A (3 × 3), b, rhs and solution (3), impulse
+# responses M⁻¹J_iᵀ and w (3 × 7), normal/lever rows (3 × 6).
+Work = namedtuple("Work", ["A", "b", "r", "lam", "resp", "geo"])
+
+
+@njit(cache=True)
+def new_work():
+    return Work(
+        np.zeros((3, 3)), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros((3, 7)), np.zeros((3, 6))
+    )
+
+
+@njit(cache=True)
+def _row_dot(geo, i, resp, j):
+    """J_i M⁻¹ J_jᵀ from contact i's normal and lever (geo row) and contact j's response."""
+    nx, ny, nz, rx, ry, rz = geo[i, 0], geo[i, 1], geo[i, 2], geo[i, 3], geo[i, 4], geo[i, 5]
+    cx, cy, cz = ry * nz - rz * ny, rz * nx - rx * nz, rx * ny - ry * nx
+    return (
+        nx * resp[j, 0]
+        + ny * resp[j, 1]
+        + nz * resp[j, 2]
+        + cx * resp[j, 3]
+        + cy * resp[j, 4]
+        + cz * resp[j, 5]
+    )
+
+
+@njit(cache=True)
+def _response(work, i):
+    r = work.resp
+    return Response(r[i, 0], r[i, 1], r[i, 2], r[i, 3], r[i, 4], r[i, 5], r[i, 6])
+
+
+@njit(cache=True)
+def contact_system(y, model, pts, idx, m, acc, work):
+    """work.A = J M⁻¹ Jᵀ, work.b = J acc + bias (normal accelerations without contact
+    forces when acc is the free acceleration), work.resp rows = M⁻¹J_iᵀ and w_i, for
+    the contacts idx[:m]."""
+    for i in range(m):
+        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        rsp = impulse_response(y, f, model.mass, model.i1, model.i3)
+        work.resp[i, 0], work.resp[i, 1], work.resp[i, 2] = rsp.dvx, rsp.dvy, rsp.dvz
+        work.resp[i, 3], work.resp[i, 4], work.resp[i, 5] = rsp.dwx, rsp.dwy, rsp.dwz
+        work.resp[i, 6] = rsp.w
+        work.geo[i, 0], work.geo[i, 1], work.geo[i, 2] = f.nx, f.ny, f.nz
+        work.geo[i, 3], work.geo[i, 4], work.geo[i, 5] = f.rx, f.ry, f.rz
+        work.b[i] = normal_acceleration(y, f, acc, model.flat_ground, pts, idx[i])
+    for i in range(m):
+        for j in range(m):
+            work.A[i, j] = work.resp[i, 6] if i == j else _row_dot(work.geo, i, work.resp, j)
+
+
+@njit(cache=True)
+def held_forces(y, model, pts, idx, m, work):
+    """Normal forces λ (into work.lam) that keep contacts idx[:m] at zero normal
+    acceleration: A λ = −b.  Returns the free acceleration and whether A was regular."""
+    acc = free_acceleration(y, model.i1, model.i3, model.gravity)
+    contact_system(y, model, pts, idx, m, acc, work)
+    for i in range(m):
+        work.r[i] = -work.b[i]
+    return acc, solve_small(work.A, work.r, m, work.lam)
+
+
+@njit(cache=True)
+def held_acceleration(y, model, pts, idx, m, work):
+    """(v̇, ω̇) with contacts idx[:m] held (forces may be negative: that is the lift-off
+    signal); the free acceleration when m = 0."""
+    acc, _ = held_forces(y, model, pts, idx, m, work)
+    ax, ay, az, bx, by, bz = acc
+    for i in range(m):
+        lam = work.lam[i]
+        ax += lam * work.resp[i, 0]
+        ay += lam * work.resp[i, 1]
+        az += lam * work.resp[i, 2]
+        bx += lam * work.resp[i, 3]
+        by += lam * work.resp[i, 4]
+        bz += lam * work.resp[i, 5]
+    return ax, ay, az, bx, by, bz
+
+
+@njit(cache=True)
+def held_rhs(y, model, pts, idx, m, work, dy):
+    """dy/dt of the held motion into dy (forces in work.lam)."""
+    acc = held_acceleration(y, model, pts, idx, m, work)
+    dy[0], dy[1], dy[2] = y[7], y[8], y[9]
+    dy[3], dy[4], dy[5], dy[6] = quaternion_rate(y)
+    for c in range(6):
+        dy[7 + c] = acc[c]
+
+
+@njit(cache=True)
+def zero_normal_velocities(y, model, pts, idx, m, work):
+    """In place: normal impulses at contacts idx[:m] that set their normal velocities to
+    zero, Δ(v, ω) = M⁻¹Jᵀ A⁻¹ (0 − u).  Returns False if A is singular."""
+    if m == 0:
+        return True
+    acc = free_acceleration(y, model.i1, model.i3, model.gravity)
+    contact_system(y, model, pts, idx, m, acc, work)
+    for i in range(m):
+        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        work.r[i] = -normal_velocity(y, f, model.flat_ground)
+    if not solve_small(work.A, work.r, m, work.lam):
+        return False
+    for i in range(m):
+        apply_impulse(y, _response(work, i), work.lam[i])
+    return True
+
+
+@njit(cache=True)
+def project_held(y, model, pts, idx, m, work):
+    """In place: project y onto the constraints of contacts idx[:m]: PROJECTION_PASSES
+    Gauss–Newton passes moving the body by M⁻¹Jᵀ A⁻¹ (−gap) (a translation and a small
+    rotation), then zero normal velocities."""
+    for _ in range(PROJECTION_PASSES):
+        acc = free_acceleration(y, model.i1, model.i3, model.gravity)
+        contact_system(y, model, pts, idx, m, acc, work)
+        for i in range(m):
+            work.r[i] = -contact_frame(y, model.flat_ground, pts, idx[i]).gap
+        if not solve_small(work.A, work.r, m, work.lam):
+            return False
+        dx = dy = dz = px = py = pz = 0.0
+        for i in range(m):
+            mu = work.lam[i]
+            dx += mu * work.resp[i, 0]
+            dy += mu * work.resp[i, 1]
+            dz += mu * work.resp[i, 2]
+            px += mu * work.resp[i, 3]
+            py += mu * work.resp[i, 4]
+            pz += mu * work.resp[i, 5]
+        y[0] += dx
+        y[1] += dy
+        y[2] += dz
+        rotate_attitude(y, px, py, pz)
+    return zero_normal_velocities(y, model, pts, idx, m, work)
+
+
+@njit(cache=True)
+def _lcp_admissible(work, m, mask, tol):
+    """Whether the active set `mask` (bits over the m candidates) solves the LCP: its
+    forces (into work.lam) are ≥ −tol(1 + |λ|) and every other candidate's normal
+    acceleration is ≥ 0."""
+    sel = np.empty(3, dtype=np.int64)
+    s = 0
+    for i in range(m):
+        if mask & (1 << i):
+            sel[s] = i
+            s += 1
+    As = np.empty((3, 3))
+    for a in range(s):
+        work.r[a] = -work.b[sel[a]]
+        for c in range(s):
+            As[a, c] = work.A[sel[a], sel[c]]
+    sol = np.zeros(3)
+    if not solve_small(As, work.r, s, sol):
+        return False
+    for a in range(s):
+        if sol[a] < -tol * (1.0 + abs(sol[a])):
+            return False
+    for i in range(m):
+        if mask & (1 << i):
+            continue
+        an = work.b[i]
+        for a in range(s):
+            an += work.A[i, sel[a]] * sol[a]
+        if not an >= 0.0:
+            return False
+    for i in range(m):
+        work.lam[i] = 0.0
+    for a in range(s):
+        work.lam[sel[a]] = sol[a]
+    return True
+
+
+@njit(cache=True)
+def solve_lcp(y, model, pts, cand, m, work, active, tol=0.0):
+    """Contacts to hold among the candidates cand[:m] (at zero gap and normal velocity):
+    the acceleration-level LCP, by enumeration from the largest active set down (sets of
+    one size in lexicographic order); the first admissible set wins (unique when A is
+    positive definite; at roundoff-level ties the larger set, holding the contact).
+    Writes the contacts with λ > 0 to `active` and returns their number, −1 when no
+    set is admissible."""
+    acc = free_acceleration(y, model.i1, model.i3, model.gravity)
+    contact_system(y, model, pts, cand, m, acc, work)
+    for size in range(m, -1, -1):
+        for mask in range(1 << m):
+            if _popcount(mask) != size or not _lcp_admissible(work, m, mask, tol):
+                continue
+            n = 0
+            for i in range(m):
+                if work.lam[i] > 0.0:
+                    active[n] = cand[i]
+                    n += 1
+            return n
+    return -1
+
+
+@njit(cache=True)
+def _popcount(mask):
+    c = 0
+    while mask:
+        c += mask & 1
+        mask >>= 1
+    return c

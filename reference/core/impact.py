@@ -1,0 +1,48 @@
+"""Single-point Newtonian impacts (paper §2.3, eqs. utk1–utk3, F, ω⁺, v⁺).
+
+An impulse ζ along contact k's normal changes (v, ω) by ζ M⁻¹Jᵀ and its normal
+velocity u by ζ w (w = J M⁻¹ Jᵀ, `inertia.impulse_response`).  Newton's law fixes u⁺
+(`post_impact_velocity`), so ζ = (u⁺ − u⁻)/w = −(1 + γ) u⁻ / w: the paper's eq. F.
+With other contacts held, the single-impact law stands only if it leaves every held
+contact separating or resting (`pushed_contacts`); otherwise the outcome is
+undecidable in this model.  Changing the impact law is an edit of
+`post_impact_velocity` alone."""
+
+from numba import njit
+
+from .contacts import contact_frame, normal_velocity
+from .inertia import apply_impulse, impulse_response
+from .records import ImpactOutcome
+
+
+@njit(cache=True)
+def post_impact_velocity(u_pre, gamma):
+    """Newton's impact law (paper eq. utk3): the contact's normal velocity after the
+    impact is −γ times the one before."""
+    return -gamma * u_pre
+
+
+@njit(cache=True)
+def impact(y, model, pts, k):
+    """In place: the impact of contact k on state y (positions unchanged)."""
+    flat = model.flat_ground
+    f = contact_frame(y, flat, pts, k)
+    u_pre = normal_velocity(y, f, flat)
+    resp = impulse_response(y, f, model.mass, model.i1, model.i3)
+    zeta = (post_impact_velocity(u_pre, model.gamma) - u_pre) / resp.w
+    apply_impulse(y, resp, zeta)
+    return ImpactOutcome(zeta, u_pre, normal_velocity(y, f, flat))
+
+
+@njit(cache=True)
+def pushed_contacts(y, model, pts, held, n_held, vnoise, out):
+    """The paper's rule beside held contacts: the held contacts that the impact just
+    applied to y leaves approaching the ground (normal velocity < −vnoise) go to `out`;
+    returns their number (0: the single-impact law stands)."""
+    n = 0
+    for i in range(n_held):
+        f = contact_frame(y, model.flat_ground, pts, held[i])
+        if normal_velocity(y, f, model.flat_ground) < -vnoise:
+            out[n] = held[i]
+            n += 1
+    return n

@@ -1,0 +1,108 @@
+"""Mass properties of the axisymmetric body (inertia m(ρa)² diag(1, 1, 2) in the body
+frame): inverse inertia in the world frame, the response of (v, ω) to a normal impulse,
+the torque-free angular acceleration, and energies (paper §2.2–2.3)."""
+
+from numba import njit
+
+from .records import Response
+from .rotation import body_axis
+
+
+@njit(cache=True)
+def inverse_inertia(e3x, e3y, e3z, i1, i3, cx, cy, cz):
+    """I⁻¹ c in the world frame: c/i1 + (1/i3 − 1/i1)(e3·c) e3."""
+    f = (1.0 / i3 - 1.0 / i1) * (e3x * cx + e3y * cy + e3z * cz)
+    return cx / i1 + f * e3x, cy / i1 + f * e3y, cz / i1 + f * e3z
+
+
+@njit(cache=True)
+def impulse_response(y, f, mass, i1, i3):
+    """M⁻¹Jᵀ and w = J M⁻¹ Jᵀ for the contact with frame f, J = [nᵀ, (r × n)ᵀ]: a normal
+    impulse ζ changes v by ζ n/m, ω by ζ I⁻¹(r × n), the normal velocity by ζ w
+    (the denominator of the paper's eq. F)."""
+    cx = f.ry * f.nz - f.rz * f.ny
+    cy = f.rz * f.nx - f.rx * f.nz
+    cz = f.rx * f.ny - f.ry * f.nx
+    e3x, e3y, e3z = body_axis(y)
+    ix, iy, iz = inverse_inertia(e3x, e3y, e3z, i1, i3, cx, cy, cz)
+    w = (f.nx * f.nx + f.ny * f.ny + f.nz * f.nz) / mass + cx * ix + cy * iy + cz * iz
+    return Response(f.nx / mass, f.ny / mass, f.nz / mass, ix, iy, iz, w)
+
+
+@njit(cache=True)
+def response_rate(f, resp):
+    """J_f M⁻¹ J_gᵀ: the change of contact f's normal velocity per unit impulse at the
+    contact of `resp` (an entry of the contact system's matrix A)."""
+    cx = f.ry * f.nz - f.rz * f.ny
+    cy = f.rz * f.nx - f.rx * f.nz
+    cz = f.rx * f.ny - f.ry * f.nx
+    return (
+        f.nx * resp.dvx
+        + f.ny * resp.dvy
+        + f.nz * resp.dvz
+        + cx * resp.dwx
+        + cy * resp.dwy
+        + cz * resp.dwz
+    )
+
+
+@njit(cache=True)
+def apply_impulse(y, resp, zeta):
+    """In place: (v, ω) += ζ M⁻¹Jᵀ."""
+    y[7] += resp.dvx * zeta
+    y[8] += resp.dvy * zeta
+    y[9] += resp.dvz * zeta
+    y[10] += resp.dwx * zeta
+    y[11] += resp.dwy * zeta
+    y[12] += resp.dwz * zeta
+
+
+@njit(cache=True)
+def free_angular_acceleration(y, i1, i3):
+    """ω̇ without contact forces, −I⁻¹(ω × Iω) (paper eq. acc2free)."""
+    e3x, e3y, e3z = body_axis(y)
+    wx, wy, wz = y[10], y[11], y[12]
+    w3 = wx * e3x + wy * e3y + wz * e3z
+    Lx = i1 * wx + (i3 - i1) * w3 * e3x
+    Ly = i1 * wy + (i3 - i1) * w3 * e3y
+    Lz = i1 * wz + (i3 - i1) * w3 * e3z
+    gx, gy, gz = wy * Lz - wz * Ly, wz * Lx - wx * Lz, wx * Ly - wy * Lx
+    ix, iy, iz = inverse_inertia(e3x, e3y, e3z, i1, i3, gx, gy, gz)
+    return -ix, -iy, -iz
+
+
+@njit(cache=True)
+def free_acceleration(y, i1, i3, gravity):
+    """(v̇, ω̇) of the free body: (0, 0, −g) and −I⁻¹(ω × Iω)."""
+    ax, ay, az = free_angular_acceleration(y, i1, i3)
+    return 0.0, 0.0, -gravity, ax, ay, az
+
+
+@njit(cache=True)
+def kinetic_energy(y, mass, i1, i3):
+    """½ m|v|² + ½ (I1 |ω⊥|² + I3 ω3²)."""
+    e3x, e3y, e3z = body_axis(y)
+    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
+    ww = y[10] ** 2 + y[11] ** 2 + y[12] ** 2
+    return 0.5 * mass * (y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + 0.5 * (
+        i1 * (ww - w3 * w3) + i3 * w3 * w3
+    )
+
+
+@njit(cache=True)
+def potential_energy(y, mass, gravity):
+    """m g z."""
+    return mass * gravity * y[2]
+
+
+@njit(cache=True)
+def excess_energy(y, flat, mass, i1, i3, gravity):
+    """Energy above the lowest level the invariants allow (the body flat on the ground):
+    flat: E − ½ m |v_h|² − L_z²/(2 I3); three-point: E − ½ I3 ω3²."""
+    e = kinetic_energy(y, mass, i1, i3) + potential_energy(y, mass, gravity)
+    e3x, e3y, e3z = body_axis(y)
+    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
+    if flat:
+        lz = i1 * y[12] + (i3 - i1) * w3 * e3z
+        return e - 0.5 * mass * (y[7] ** 2 + y[8] ** 2) - lz * lz / (2.0 * i3)
+    return e - 0.5 * i3 * w3 * w3

@@ -1,0 +1,148 @@
+"""The event loop of the exact reference (the one entry point Python calls).
+
+Phases alternate between closed-form free flight and sustained contact with one or two
+points, separated by instantaneous events: single-point Newtonian impacts, lift-off
+(a held force reaching zero), activations, chatter completion.  The run stops with an
+explicit status and never guesses:
+
+- two contacts reached within the time resolution, or an impact that would drive a
+  held contact into the ground (the paper's rule), end it as undecidable;
+- all contacts down, or the energy above the resting level exhausted to
+  `energy_floor` of its initial value, end it at the singularity, with t_singularity
+  (extrapolated from the geometric sequence of the last impact intervals).
+
+Time is a double-double and every phase runs in its own local time, so intervals near
+the singularity keep their digits.  The loop returns to Python after `work_budget`
+steps (so that a long run can show progress and be interrupted) and when its output
+arrays are full; the state record holds everything needed to resume."""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .clock import time_until
+from .events import end_run, start
+from .inertia import excess_energy
+from .output import Output
+from .phases import NEEDS_ROWS, begin_contact_phase, contact_step, flight_step
+from .records import (
+    N_ACCUMULATIONS,
+    N_IMPACTS,
+    N_PHASES,
+    RETURN_DONE,
+    RETURN_GROW,
+    RETURN_YIELD,
+    STATUS_ENERGY_EXHAUSTED,
+    STATUS_FAILED_NONFINITE,
+    STATUS_MAX_IMPACTS,
+    STATUS_RUNNING,
+    STATUS_SINGULARITY,
+    STATUS_T_END,
+)
+from .workspace import new_workspace
+
+# rows every step may add at most to impacts, phases and accumulation times
+STEP_ROWS = 4
+
+
+@njit(cache=True)
+def extrapolate_singularity(out, t_hi):
+    """t_f from the last three impacts, assuming geometric intervals τ_{k+1} = r τ_k:
+    t_f = t_3 + τ_2 r/(1 − r); the current time when that does not apply."""
+    n = out.counts[N_IMPACTS]
+    if n < 3:
+        return t_hi
+    a, b, c = out.impacts[n - 3], out.impacts[n - 2], out.impacts[n - 1]
+    tau1 = (b[0] - a[0]) + (b[1] - a[1])
+    tau2 = (c[0] - b[0]) + (c[1] - b[1])
+    if tau1 <= 0 or not 0 < tau2 / tau1 < 1:
+        return t_hi
+    r = tau2 / tau1
+    return c[0] + (c[1] + tau2 * r / (1 - r))
+
+
+@njit(cache=True)
+def _motion_ended(state, model, opts, out):
+    """The end checks between phases (max_impacts, all contacts down, energy exhausted,
+    t_end); sets the status and returns True when one applies."""
+    none = np.empty(0, dtype=np.int64)
+    if out.counts[N_IMPACTS] >= opts.max_impacts:
+        end_run(state, STATUS_MAX_IMPACTS, none, 0)
+        return True
+    if state.n_active >= model.all_down:
+        end_run(state, STATUS_SINGULARITY, state.active, min(state.n_active, 3))
+        state.t_singularity = state.t_hi
+        return True
+    y = state.y
+    if state.excess0 > 0:
+        e = excess_energy(y, model.flat_ground, model.mass, model.i1, model.i3, model.gravity)
+        if e <= opts.energy_floor * state.excess0:
+            end_run(state, STATUS_ENERGY_EXHAUSTED, none, 0)
+            state.t_singularity = extrapolate_singularity(out, state.t_hi)
+            return True
+    if time_until(state.t_hi, state.t_lo, opts.t_end) <= 0:
+        end_run(state, STATUS_T_END, none, 0)
+        return True
+    return False
+
+
+@njit(cache=True)
+def _rows_short(out):
+    """Whether impacts, phases or accumulation times have fewer than STEP_ROWS free rows."""
+    c = out.counts
+    return (
+        out.impacts.shape[0] - c[N_IMPACTS] < STEP_ROWS
+        or out.phases.shape[0] - c[N_PHASES] < STEP_ROWS
+        or out.accumulations.shape[0] - c[N_ACCUMULATIONS] < STEP_ROWS
+    )
+
+
+@njit(cache=True)
+def _finite(y):
+    for c in range(13):
+        if not math.isfinite(y[c]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def loop_step(state, model, pts, opts, stats, out, ws):
+    """One step: the run's start, a contact chunk (or the event ending the phase), or a
+    flight to its event, after the end checks between phases."""
+    if not state.started:
+        start(state, model, pts, opts, stats, out, ws)
+        return 0
+    if state.in_contact:
+        return contact_step(state, model, pts, opts, stats, out, ws)
+    if _motion_ended(state, model, opts, out):
+        return 0
+    if state.n_active > 0:
+        begin_contact_phase(state, model, opts)
+        return contact_step(state, model, pts, opts, stats, out, ws)
+    return flight_step(state, model, pts, opts, stats, out, ws)
+
+
+@njit(cache=True)
+def run_events(
+    model_rec, pts, opts_rec, state_rec, stats_rec, sample_t, sample_y, sample_e, impacts,
+    phases, accumulations, counts,
+):  # fmt: skip
+    """Run the loop from the state in state_rec until the run ends (RETURN_DONE), an
+    output array needs rows (RETURN_GROW) or work_budget steps are done
+    (RETURN_YIELD).  Records are 1-element structured arrays (records.MODEL, OPTIONS,
+    STATE, STATS); the output arrays and their row counts are those of output.Output."""
+    model, opts, state, stats = model_rec[0], opts_rec[0], state_rec[0], stats_rec[0]
+    out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, counts)
+    ws = new_workspace(pts.shape[0])
+    for _ in range(opts.work_budget):
+        if state.status != STATUS_RUNNING:
+            return RETURN_DONE
+        if _rows_short(out):
+            return RETURN_GROW
+        if loop_step(state, model, pts, opts, stats, out, ws) == NEEDS_ROWS:
+            return RETURN_GROW
+        stats.loop_steps += 1
+        if state.status == STATUS_RUNNING and not _finite(state.y):
+            end_run(state, STATUS_FAILED_NONFINITE, ws.together, 0)
+    return RETURN_DONE if state.status != STATUS_RUNNING else RETURN_YIELD

@@ -1,0 +1,360 @@
+"""One step of the loop in each kind of phase: a free flight up to its event, or one
+chunk of a contact phase (or the event that ends it).  A step that needs more output
+rows than are free returns NEEDS_ROWS before it changes anything, so the caller can
+grow the arrays and redo it identically."""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .clock import time_until, two_sum_add
+from .contacts import contact_frame, contact_jet, length_scale, rate_noise, velocity_scale
+from .dop853 import INT_FAILED, INT_LIFT_OFF, integrate_held
+from .events import activate, end_run, hold, resolve_impact
+from .flight import flight_bounds, flight_constants, free_flight
+from .held import held_acceleration, held_forces, project_held
+from .horizon import chunk_horizon, force_trend_limit
+from .inertia import kinetic_energy, potential_energy
+from .output import push_phase, push_sample
+from .records import (
+    EVENT_ACTIVATION,
+    EVENT_NONE,
+    EVENT_STUCK,
+    N_SAMPLES,
+    PHASE_CONTACT,
+    PHASE_FLIGHT,
+    STATUS_FAILED_INTEGRATION,
+    STATUS_FAILED_NO_ADVANCE,
+    STATUS_FAILED_STUCK,
+)
+from .search import find_flight_event
+from .tolerances import (
+    CONTACT_GAP_RES,
+    LOCATE_ITERATIONS,
+    LOCATE_XTOL,
+    MAX_SEARCH_ITERATIONS,
+    TINY,
+)
+
+DONE, NEEDS_ROWS = 0, 1
+
+
+@njit(cache=True)
+def grid_count(t_hi, t_lo, s_end, dt):
+    """Number of sample-grid times k·dt inside (t, t + s_end)."""
+    if not s_end > 0.0:
+        return 0
+    k0 = math.floor(t_hi / dt) + 1
+    first = k0 * dt - t_hi - t_lo
+    if first <= 0.0:
+        first += dt
+    if first >= s_end:
+        return 0
+    return int(math.ceil((s_end - first) / dt)) + 1
+
+
+@njit(cache=True)
+def grid_times(t_hi, t_lo, s_end, dt, out):
+    """The sample-grid times inside (0, s_end) of local time from t (the same rule as
+    `grid_count`, but each tested); returns how many were written."""
+    kk = math.floor(t_hi / dt) + 1
+    n = 0
+    while n < out.shape[0]:
+        s = kk * dt - t_hi - t_lo
+        if s >= s_end:
+            break
+        if s > 0:
+            out[n] = s
+            n += 1
+        kk += 1
+    return n
+
+
+@njit(cache=True)
+def _needed(n_grid, out, opts):
+    """Whether n_grid samples (and a few event samples) do not fit in the free rows
+    (counting only what max_samples still admits)."""
+    n = out.counts[N_SAMPLES]
+    need = min(n_grid + 4, max(opts.max_samples - n, 0))
+    return need > out.sample_t.shape[0] - n
+
+
+@njit(cache=True)
+def flight_step(state, model, pts, opts, stats, out, ws):
+    """Free flight from the state to its first event (or to t_end), then the event."""
+    y = state.y
+    remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
+    fc = flight_constants(y, model.i1, model.i3)
+    bounds = flight_bounds(y, fc, model, pts, remaining)
+    ev = find_flight_event(
+        y, fc, bounds, model, pts, opts.window_search, remaining, MAX_SEARCH_ITERATIONS,
+        ws.y_event, ws.together,
+    )  # fmt: skip
+    if ev.kind == EVENT_STUCK:
+        end_run(state, STATUS_FAILED_STUCK, ws.together, 0)
+        return DONE
+    n_grid = grid_count(state.t_hi, state.t_lo, ev.s, opts.sample_dt)
+    if _needed(n_grid, out, opts):
+        return NEEDS_ROWS
+    stats.flight_searches += 1
+    stats.search_iterations += ev.iterations
+    kk = math.floor(state.t_hi / opts.sample_dt) + 1
+    while True:
+        s = kk * opts.sample_dt - state.t_hi - state.t_lo
+        if s >= ev.s:
+            break
+        if s > 0:
+            free_flight(y, fc, model.gravity, s, ws.y_chunk)
+            hi, lo = two_sum_add(state.t_hi, state.t_lo, s)
+            push_sample(out, hi, lo, ws.y_chunk, model, opts.max_samples)
+        kk += 1
+    t0 = state.t_hi
+    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, ev.s)
+    y[:] = ws.y_event
+    push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
+    push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    if ev.kind == EVENT_NONE:
+        return DONE
+    if ev.kind == EVENT_ACTIVATION:
+        activate(state, model, pts, ws, stats, ws.together, ev.n_together)
+        return DONE
+    hitting = ws.together[: ev.n_together].copy()
+    resolve_impact(state, model, pts, opts, stats, out, ws, hitting, ev.n_together, state.active, 0)
+    return DONE
+
+
+@njit(cache=True)
+def begin_contact_phase(state, model, opts):
+    """Enter a contact phase with the held contacts: its start, energy and gap
+    resolution (roundoff, or the integrator's tolerance on the positions:
+    CONTACT_GAP_RES × rtol × the phase's length scale)."""
+    y = state.y
+    state.in_contact = True
+    state.phase_t0 = state.t_hi
+    state.gap_res = CONTACT_GAP_RES * opts.contact_rtol * length_scale(y, model.radius)
+    state.phase_energy0 = kinetic_energy(y, model.mass, model.i1, model.i3) + potential_energy(
+        y, model.mass, model.gravity
+    )
+    state.has_trend = False
+
+
+@njit(cache=True)
+def close_contact_phase(state, model, stats, out):
+    """Record the contact phase that ends now and its energy drift."""
+    y = state.y
+    push_phase(out, state.phase_t0, state.t_hi, PHASE_CONTACT, state.active, state.n_active)
+    e = kinetic_energy(y, model.mass, model.i1, model.i3) + potential_energy(
+        y, model.mass, model.gravity
+    )
+    e0 = state.phase_energy0
+    stats.contact_energy_drift_max = max(
+        stats.contact_energy_drift_max, abs(e - e0) / max(abs(e0), TINY)
+    )
+    stats.contact_phases += 1
+    state.in_contact = False
+
+
+@njit(cache=True)
+def _contact_jets(state, model, pts, ws):
+    """Jets of every contact with the held acceleration (forces into ws.work.lam)."""
+    acc = held_acceleration(state.y, model, pts, state.active, state.n_active, ws.work)
+    for k in range(pts.shape[0]):
+        j = contact_jet(state.y, model.flat_ground, pts, k, acc)
+        ws.gap[k], ws.rate[k], ws.accel[k], ws.noise[k] = j.gap, j.rate, j.accel, j.noise
+        ws.held[k] = False
+    for i in range(state.n_active):
+        ws.held[state.active[i]] = True
+
+
+@njit(cache=True)
+def _touching_event(state, model, pts, opts, stats, out, ws, gap_res):
+    """A free contact touching (gap within max(noise, gap_res)) while approaching (an
+    impact with the held ones) or at rest accelerating into the ground (activation)
+    ends the phase.  Returns True if so."""
+    vnoise = rate_noise(state.y, model.radius)
+    n_hit = n_land = 0
+    hitting = np.empty(pts.shape[0], dtype=np.int64)
+    for k in range(pts.shape[0]):
+        if ws.held[k] or ws.gap[k] > max(ws.noise[k], gap_res):
+            continue
+        if ws.rate[k] < -vnoise:
+            hitting[n_hit] = k
+            n_hit += 1
+        elif ws.rate[k] <= vnoise and ws.accel[k] < 0:
+            ws.together[n_land] = k
+            n_land += 1
+    if n_hit:
+        close_contact_phase(state, model, stats, out)
+        held = state.active[: state.n_active].copy()
+        resolve_impact(
+            state, model, pts, opts, stats, out, ws, hitting, n_hit, held, state.n_active
+        )
+        return True
+    if n_land:
+        close_contact_phase(state, model, stats, out)
+        activate(state, model, pts, ws, stats, ws.together, n_land)
+        return True
+    return False
+
+
+@njit(cache=True)
+def _set_tolerances(y, model, rtol, atol):
+    """Absolute tolerances of a chunk: rtol × the length scale for positions (over a for
+    the quaternion), rtol × the velocity scale for velocities (over a for ω)."""
+    scale_x = length_scale(y, model.radius) + TINY
+    scale_v = velocity_scale(y, model.radius) + TINY
+    for c in range(3):
+        atol[c] = rtol * scale_x
+        atol[7 + c] = rtol * scale_v
+        atol[10 + c] = rtol * scale_v / model.radius
+    for c in range(3, 7):
+        atol[c] = rtol * scale_x / model.radius
+
+
+@njit(cache=True)
+def _crossed(y, model, pts, ws, gap_res):
+    """Free contacts below the ground beyond their resolution at y: how many (listed in
+    ws.together)."""
+    n = 0
+    for k in range(pts.shape[0]):
+        if ws.held[k]:
+            continue
+        f = contact_frame(y, model.flat_ground, pts, k)
+        if f.gap < -max(f.noise, gap_res):
+            ws.together[n] = k
+            n += 1
+    return n
+
+
+@njit(cache=True)
+def _min_gap_after(state, model, pts, opts, ws, s, n_crossed, out):
+    """Lowest gap of the crossed contacts after integrating (and projecting) the held
+    motion for s from the chunk's start (ws.y_start); the state into ws.y_chunk."""
+    ws.y_chunk[:] = ws.y_start
+    grid = np.empty(0)
+    r = integrate_held(
+        ws.y_chunk, s, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
+        ws.work, ws.stepper, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False,
+    )  # fmt: skip
+    project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws.work)
+    g = math.inf
+    for i in range(n_crossed):
+        g = min(g, contact_frame(ws.y_chunk, model.flat_ground, pts, ws.together[i]).gap)
+    return g, r.nfev
+
+
+@njit(cache=True)
+def _locate_crossing(state, model, pts, opts, stats, out, ws, h, n_crossed):
+    """The first time in (0, h] the crossed contacts reach the ground (bisection on
+    re-integrations from the chunk's start): the horizon's backstop (it should be rare:
+    the bound makes crossings impossible up to roundoff)."""
+    lo, hi = 0.0, h
+    for _ in range(LOCATE_ITERATIONS):
+        if hi - lo <= LOCATE_XTOL * h + 4.0 * 2.220446049250313e-16 * hi:
+            break
+        mid = 0.5 * (lo + hi)
+        g, nfev = _min_gap_after(state, model, pts, opts, ws, mid, n_crossed, out)
+        stats.contact_rhs_evals += nfev
+        if g > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    g, nfev = _min_gap_after(state, model, pts, opts, ws, hi, n_crossed, out)
+    stats.contact_rhs_evals += nfev
+    return hi
+
+
+@njit(cache=True)
+def contact_step(state, model, pts, opts, stats, out, ws):
+    """One step of a contact phase: the event that ends it, or one integrated chunk."""
+    y = state.y
+    gap_res = state.gap_res
+    _contact_jets(state, model, pts, ws)
+    if _touching_event(state, model, pts, opts, stats, out, ws, gap_res):
+        return DONE
+    m = state.n_active
+    lam = ws.work.lam[:m].copy()
+    remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
+    h = chunk_horizon(y, model, ws.gap, ws.rate, ws.accel, ws.noise, ws.held)
+    if state.has_trend:
+        h = force_trend_limit(h, lam, state.lam_prev, state.h_prev, m)
+    h = min(h, remaining)
+    if h <= 0:
+        close_contact_phase(state, model, stats, out)
+        if remaining > 0:
+            end_run(state, STATUS_FAILED_NO_ADVANCE, state.active, state.n_active)
+        return DONE
+    n_grid = grid_count(state.t_hi, state.t_lo, h, opts.sample_dt)
+    if _needed(n_grid, out, opts):
+        return NEEDS_ROWS
+    grid = np.empty(n_grid + 1)
+    n_grid = grid_times(state.t_hi, state.t_lo, h, opts.sample_dt, grid)
+    _set_tolerances(y, model, opts.contact_rtol, ws.atol)
+    ws.y_start[:] = y
+    ws.y_chunk[:] = y
+    ns0 = out.counts[N_SAMPLES]
+    r = integrate_held(
+        ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws.work,
+        ws.stepper, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True,
+    )  # fmt: skip
+    stats.contact_rhs_evals += r.nfev
+    if r.status == INT_FAILED:
+        end_run(state, STATUS_FAILED_INTEGRATION, state.active, m)
+        return DONE
+    project_held(ws.y_chunk, model, pts, state.active, m, ws.work)
+    if r.status == INT_LIFT_OFF:
+        return _lift_off(state, model, pts, opts, stats, out, ws, r)
+    n_crossed = _crossed(ws.y_chunk, model, pts, ws, gap_res)
+    if n_crossed:
+        stats.horizon_backstops += 1
+        s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, h, n_crossed)
+        _drop_samples_after(out, ns0, state, s_star)
+        state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_star)
+        y[:] = ws.y_chunk
+        state.has_trend = False
+        return DONE
+    stats.contact_chunks += 1
+    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
+    y[:] = ws.y_chunk
+    _, ok = held_forces(y, model, pts, state.active, m, ws.work)
+    for i in range(m):
+        state.lam_prev[i] = ws.work.lam[i]
+    state.h_prev = h
+    state.has_trend = True
+    if remaining - h <= 0:
+        push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+        close_contact_phase(state, model, stats, out)
+    return DONE
+
+
+@njit(cache=True)
+def _drop_samples_after(out, ns0, state, s_star):
+    """Forget the chunk's grid samples at local times ≥ s_star (the chunk was cut)."""
+    n = out.counts[N_SAMPLES]
+    keep = ns0
+    for i in range(ns0, n):
+        if time_until(state.t_hi, state.t_lo, out.sample_t[i, 0]) + out.sample_t[i, 1] < s_star:
+            keep = i + 1
+    out.counts[N_SAMPLES] = keep
+
+
+@njit(cache=True)
+def _lift_off(state, model, pts, opts, stats, out, ws, r):
+    """A held force reached zero at r.s: advance there, close the phase, and hold the
+    others that the LCP keeps."""
+    y = state.y
+    stats.lift_offs += 1
+    if r.s > 0.0:
+        stats.contact_chunks += 1
+        state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, r.s)
+        y[:] = ws.y_chunk
+    push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    close_contact_phase(state, model, stats, out)
+    m = 0
+    for i in range(state.n_active):
+        if i != r.leaving:
+            ws.cand[m] = state.active[i]
+            m += 1
+    hold(state, model, pts, ws, ws.cand, m)
+    return DONE

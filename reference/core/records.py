@@ -1,0 +1,138 @@
+"""Named results of the core's functions (namedtuples, compiled as structs) and the record
+layouts that cross the Python boundary (numpy structured dtypes, read by field name on
+both sides)."""
+
+from collections import namedtuple
+
+import numpy as np
+
+# ----------------------------------------------------------------------------- results
+
+# A contact's geometry at a state: gap, unit normal n, lever r (contact point − centre of
+# mass, world frame), roundoff level of the gap.
+Frame = namedtuple("Frame", ["gap", "nx", "ny", "nz", "rx", "ry", "rz", "noise"])
+# Gap, its first and second time derivatives, and the gap's roundoff level.
+Jet = namedtuple("Jet", ["gap", "rate", "accel", "noise"])
+# An impulse ζ along a contact normal changes (v, ω) by ζ (dv, dw) = ζ M⁻¹Jᵀ and the
+# contact's normal velocity by ζ w, w = J M⁻¹ Jᵀ (the inverse effective mass).
+Response = namedtuple("Response", ["dvx", "dvy", "dvz", "dwx", "dwy", "dwz", "w"])
+# What stays fixed along a free flight: L/A (world), the spin rate λ about e3 relative
+# to the precessing frame, |ω| and the precession rate Ω = |L|/A.
+FlightConstants = namedtuple("FlightConstants", ["lax", "lay", "laz", "lam", "wabs", "omega"])
+# Bounds on |g″| and |g‴| of every gap over a flight.
+Bounds = namedtuple("Bounds", ["K", "B"])
+# An impact's impulse and the contact's normal velocity before and after it.
+ImpactOutcome = namedtuple("ImpactOutcome", ["impulse", "u_pre", "u_post"])
+# The next event of a free flight: kind (EVENT_*), time s from the flight's start, the
+# contact, how many contacts are reached together, search iterations.
+FlightEvent = namedtuple("FlightEvent", ["kind", "s", "contact", "n_together", "iterations"])
+
+EVENT_NONE = 0  # nothing reached within the horizon
+EVENT_IMPACT = 1  # a contact reached while approaching
+EVENT_ACTIVATION = 2  # a contact touching at rest with its acceleration into the ground
+EVENT_STUCK = 3  # the search did not converge
+
+# ----------------------------------------------------------------------------- layouts
+
+# The body, its ground and the impact law, as the core reads them.
+MODEL = np.dtype(
+    [
+        ("mass", np.float64),
+        ("i1", np.float64),  # inertia about in-plane axes, m (ρa)²
+        ("i3", np.float64),  # inertia about the symmetry axis, 2 m (ρa)²
+        ("radius", np.float64),  # a
+        ("gravity", np.float64),  # g (along −z)
+        ("gamma", np.float64),  # Newton's restitution coefficient γ
+        ("flat_ground", np.bool_),  # flat ground (contacts = vertices), or three bumps
+        ("n_contacts", np.int64),
+        ("all_down", np.int64),  # contacts held together that end the motion
+    ]
+)
+
+# Run settings and tolerances (reference.options.ReferenceOptions).
+OPTIONS = np.dtype(
+    [
+        ("t_end", np.float64),
+        ("sample_dt", np.float64),
+        ("chatter_tol", np.float64),
+        ("contact_rtol", np.float64),
+        ("energy_floor", np.float64),
+        ("max_samples", np.int64),
+        ("max_impacts", np.int64),
+        ("window_search", np.bool_),  # large polygons: examine only the vertices near the ground
+        ("work_budget", np.int64),  # loop steps per call before control returns to Python
+    ]
+)
+
+# The loop's state: everything needed to resume it after it returns to Python.
+STATE = np.dtype(
+    [
+        ("y", np.float64, (13,)),  # x, q (w, x, y, z), v, ω (world)
+        ("t_hi", np.float64),  # time as a double-double t_hi + t_lo
+        ("t_lo", np.float64),
+        ("excess0", np.float64),  # initial energy above the resting level
+        ("n_active", np.int64),  # contacts held
+        ("active", np.int64, (3,)),
+        ("in_contact", np.bool_),  # inside a contact phase
+        ("phase_t0", np.float64),  # the current phase's start
+        ("phase_energy0", np.float64),  # energy at the contact phase's start
+        ("gap_res", np.float64),  # the contact phase's gap resolution
+        ("has_trend", np.bool_),  # lam_prev / h_prev hold the previous chunk's forces
+        ("lam_prev", np.float64, (2,)),
+        ("h_prev", np.float64),
+        ("started", np.bool_),  # the initial contacts have been resolved
+        ("status", np.int64),  # STATUS_* once the run has ended
+        ("info_t", np.float64),  # time of the event that ended the run
+        ("info_contact", np.int64),  # contact of that event (−1: none)
+        ("n_info", np.int64),  # contacts involved (simultaneous impact)
+        ("info", np.int64, (16,)),
+        ("t_singularity", np.float64),  # NaN unless the run reached the singularity
+    ]
+)
+
+STATUS_RUNNING = -1
+STATUS_T_END = 0
+STATUS_SINGULARITY = 1  # all contacts down
+STATUS_ENERGY_EXHAUSTED = 2  # singularity: excess energy ≤ floor × initial
+STATUS_SIMULTANEOUS = 3  # contacts reached together
+STATUS_PUSHED = 4  # an impact would push a held contact into the ground
+STATUS_MAX_IMPACTS = 5
+STATUS_FAILED_NONFINITE = 6
+STATUS_FAILED_LCP = 7  # the complementarity problem has no solution
+STATUS_FAILED_STUCK = 8  # the event search did not converge
+STATUS_FAILED_INTEGRATION = 9  # the contact integrator's step fell below roundoff
+STATUS_FAILED_NO_ADVANCE = 10  # a contact phase cannot advance before t_end
+STATUS_AT_REST = 11  # singularity at the start: all contacts down and at rest
+
+# Counters of a run (reference.stats.RunStats reads them by name).
+STATS = np.dtype(
+    [
+        ("flight_searches", np.int64),
+        ("search_iterations", np.int64),
+        ("contact_phases", np.int64),
+        ("contact_chunks", np.int64),
+        ("contact_rhs_evals", np.int64),
+        ("chatter_completions", np.int64),
+        ("max_completion_u_rel", np.float64),
+        ("activations", np.int64),
+        ("lift_offs", np.int64),
+        ("horizon_backstops", np.int64),
+        ("contact_energy_drift_max", np.float64),
+        ("max_penetration", np.float64),
+        ("loop_steps", np.int64),
+    ]
+)
+
+# Columns of the impact rows the loop writes.
+IMPACT_COLUMNS = ("t", "t_lo", "contact", "impulse", "v_normal_pre", "v_normal_post")
+# Columns of the phase rows: kind 0 = flight, 1 = contact (held contacts, −1 padded).
+PHASE_COLUMNS = ("t_start", "t_end", "kind", "contact0", "contact1", "contact2")
+PHASE_FLIGHT, PHASE_CONTACT = 0, 1
+
+# What run_events returns
+RETURN_DONE = 0  # the run has ended (state.status)
+RETURN_YIELD = 1  # work_budget steps done: call again to go on
+RETURN_GROW = 2  # an output array needs more rows: grow it and call again
+
+# counts[...] of the output arrays: rows written of each, and the overflow flag
+N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS, OVERFLOW = range(5)

@@ -1,0 +1,144 @@
+"""Conservative advancement: the first positive root of a lower bound of a gap.
+
+From a gap's value g, rate g′ and acceleration g″ now, and bounds K ≥ |g″|, B ≥ |g‴|
+over the step, two polynomials bound it from below:
+
+    P2(δ) = g + g′δ − K δ²/2,     P3(δ) = g + g′δ + g″δ²/2 − B δ³/6.
+
+The gap stays positive until the first positive root of max(P2, P3) (`safe_step`), so
+advancing by it never steps over a contact.  Near a transversal root the step tends to
+g/|g′| (Newton from the safe side: quadratic convergence); near a grazing minimum P3
+lets the search pass it in a few steps."""
+
+import math
+
+from numba import njit
+
+from .tolerances import ROOT_REL_TOL
+
+
+@njit(cache=True)
+def _cubic_value(c0, c1, c2, c3, x):
+    return c0 + x * (c1 + x * (c2 + x * c3))
+
+
+@njit(cache=True)
+def _critical_points(c1, c2, c3):
+    """The critical points of the cubic (roots of 3c3 x² + 2c2 x + c1),
+    sorted: (count, first, second)."""
+    a, b, c = 3.0 * c3, 2.0 * c2, c1
+    if a == 0.0:
+        if b != 0.0:
+            return 1, -c / b, 0.0
+        return 0, 0.0, 0.0
+    disc = b * b - 4 * a * c
+    if disc < 0:
+        return 0, 0.0, 0.0
+    qq = -0.5 * (b + math.copysign(math.sqrt(disc), b))
+    if qq == 0:
+        return 0, 0.0, 0.0
+    r0, r1 = qq / a, c / qq
+    return 2, min(r0, r1), max(r0, r1)
+
+
+@njit(cache=True)
+def _monotone_root(c0, c1, c2, c3, lo, hi):
+    """A point below the root of the cubic on [lo, hi] (monotone there, positive at lo,
+    ≤ 0 at hi), within ROOT_REL_TOL of it: safeguarded Newton, pushed a little past
+    the root once its step is below the tolerance so that the bracket closes."""
+    x = 0.5 * (lo + hi)
+    for _ in range(200):
+        f = _cubic_value(c0, c1, c2, c3, x)
+        if f > 0.0:
+            lo = x
+        else:
+            hi = x
+        tol = ROOT_REL_TOL * hi
+        if hi - lo <= tol:
+            break
+        d = c1 + x * (2.0 * c2 + 3.0 * x * c3)
+        nxt = x - f / d if d != 0.0 else 0.5 * (lo + hi)
+        if abs(nxt - x) < 0.25 * tol:
+            nxt += math.copysign(0.25 * tol, nxt - x)
+        if not lo < nxt < hi:
+            nxt = 0.5 * (lo + hi)
+        x = nxt
+    return lo
+
+
+@njit(cache=True)
+def cubic_first_root(c0, c1, c2, c3):
+    """First positive root of c0 + c1 x + c2 x² + c3 x³ (c0 > 0, c3 ≤ 0), from below
+    within ROOT_REL_TOL; inf if there is none.  The critical points split (0, ∞) into
+    monotone pieces; the first whose end value is ≤ 0 holds the root."""
+    m, cr0, cr1 = _critical_points(c1, c2, c3)
+    lo = 0.0
+    for i in range(m + 1):
+        if i < m:
+            hi = cr0 if i == 0 else cr1
+            if hi <= lo:
+                continue
+        else:
+            if not (c3 < 0 or (c3 == 0 and (c2 < 0 or (c2 == 0 and c1 < 0)))):
+                return math.inf
+            hi = max(lo, 1.0)
+            while _cubic_value(c0, c1, c2, c3, hi) > 0:
+                hi *= 2.0
+                if hi > 1e300:
+                    return math.inf
+        if _cubic_value(c0, c1, c2, c3, hi) <= 0.0:
+            return _monotone_root(c0, c1, c2, c3, lo, hi)
+        lo = hi
+    return math.inf
+
+
+@njit(cache=True)
+def cubic_positive_on(c0, c1, c2, c3, T):
+    """Whether the cubic (c0 > 0, c3 ≤ 0) stays positive on [0, T]: positive at T and at
+    its local minimum (where the derivative turns from negative to positive) if that
+    lies inside."""
+    if _cubic_value(c0, c1, c2, c3, T) <= 0.0:
+        return False
+    a, b, c = 3.0 * c3, 2.0 * c2, c1
+    if a == 0.0:
+        if b <= 0.0:
+            return True  # concave or linear: the ends decide
+        dm = -c / b
+    else:
+        disc = b * b - 4.0 * a * c
+        if disc <= 0.0:
+            return True  # the derivative is never positive: decreasing, the ends decide
+        sq = math.sqrt(disc)
+        dm = min((-b + sq) / (2.0 * a), (-b - sq) / (2.0 * a))
+    if 0.0 < dm < T:
+        return _cubic_value(c0, c1, c2, c3, dm) > 0.0
+    return True
+
+
+@njit(cache=True)
+def quadratic_first_root(g, g1, K):
+    """First positive root of P2 = g + g1 δ − K δ²/2 (g > 0), in the cancellation-free
+    form for g1's sign; inf if there is none."""
+    if K > 0.0:
+        sq = math.sqrt(g1 * g1 + 2.0 * K * g)
+        return (g1 + sq) / K if g1 >= 0.0 else 2.0 * g / (sq - g1)
+    if g1 < 0.0:
+        return g / -g1
+    return math.inf
+
+
+@njit(cache=True)
+def safe_step(g, g1, g2, K, B, cap=math.inf):
+    """First positive root of max(P2, P3): no contact before it; 0 if g ≤ 0.
+
+    When P2's root is already ≥ `cap` (the smallest step found so far among other
+    contacts), or P3 stays positive up to `cap`, this contact does not bind the step and
+    P3 is not solved: a value ≥ cap is returned."""
+    if g <= 0.0:
+        return 0.0
+    d2 = quadratic_first_root(g, g1, K)
+    if d2 >= cap:
+        return d2
+    if cap < math.inf and cubic_positive_on(g, g1, 0.5 * g2, -B / 6.0, cap):
+        return cap
+    return max(d2, cubic_first_root(g, g1, 0.5 * g2, -B / 6.0))

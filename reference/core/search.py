@@ -1,0 +1,325 @@
+"""The next event of a free flight, never missed (conservative advancement).
+
+Each step finds, for every contact that can bind it, the first root of the lower bound
+max(P2, P3) of its gap (`roots.safe_step`) and advances the closed-form flight by the
+smallest.  A contact is reached when its gap is within roundoff while approaching
+faster than a graze could (an impact, its time then Newton-polished), or while at rest
+and pressing into the ground (an activation: it starts to be held).  Contacts whose
+zeros are within their time resolution of the first one's are reached together
+(`collect_together`): the model cannot order them.
+
+Large polygons (n > SMALL_N) over flat ground examine only the vertices that can touch
+within the step: a vertex's gap, rate and acceleration are linear in its body-frame
+position a(cos θ, sin θ), so its quadratic bound over a step δ is a sinusoid in θ and
+only an angular window around the lowest direction can reach the ground within δ
+(`vertex_window`); far from the ground the circle through the vertices bounds them all
+at once (`circle_step`).  The cost per step does not grow with n."""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .contacts import contact_jet, point_jet
+from .flight import flight_acceleration, free_flight
+from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
+from .roots import safe_step
+from .rotation import rotation_columns_xy
+from .tolerances import (
+    EPS,
+    GRAZE_FACTOR,
+    MIN_STEP_REL,
+    POLISH_ITERATIONS,
+    POLISH_REL_TOL,
+    RATE_NOISE_ULPS,
+    SIMULTANEOUS_FACTOR,
+    SMALL_N,
+    TINY,
+    WINDOW_MAX,
+)
+
+# res[...] of `examine`: the smallest safe step, the earliest hit's time and contact, a
+# contact landing at rest
+STEP, HIT_DS, HIT_K, LAND_K = range(4)
+
+
+@njit(cache=True)
+def examine(y, acc, flat, pts, k, K, B, vnoise, res):
+    """Examine contact k at state y: update res with its safe step, or record it as hit
+    (touching and approaching faster than a graze) or landing (touching at rest,
+    accelerating into the ground)."""
+    j = contact_jet(y, flat, pts, k, acc)
+    g = j.gap
+    if g <= j.noise:
+        graze = GRAZE_FACTOR * math.sqrt(2.0 * max(j.accel, 0.0) * j.noise)
+        if j.rate < -max(vnoise, graze):
+            ds = -g / j.rate
+            if ds < res[HIT_DS]:
+                res[HIT_DS] = ds
+                res[HIT_K] = k
+            return
+        if j.rate <= vnoise and j.accel < 0:
+            res[LAND_K] = k
+        g = max(g, 0.0) + j.noise  # touching, not approaching: bound from the safe side
+    d = safe_step(g, j.rate, j.accel, K, B, res[STEP])
+    if d < res[STEP]:
+        res[STEP] = d
+
+
+@njit(cache=True)
+def vertex_window(y, radius, n, K, delta, margin):
+    """The vertices that can reach the ground within δ (the others are safe by P2): the
+    index range k0 − half … k0 + half (mod n) around the lowest direction; O(1).
+
+    P2 of vertex k at δ is Z(δ) + a c_k·u(δ) with c_k = (cos θ_k, sin θ_k),
+    Z = z + v_z δ − Kδ²/2 and u = (R20, R21) + δ (ω × R)'s z row: a vertex's height and
+    rate are linear in its body position.  P2 is concave in δ, so vertex k is safe over
+    [0, δ] when a|u| cos(θ_k − ∠u) > −Z: outside an arc of half-width π − acos(−Z/(a|u|))
+    around ∠u + π.  half = n // 2 means every vertex."""
+    R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y)
+    A = y[10] * R10 - y[11] * R00
+    Bq = y[10] * R11 - y[11] * R01
+    ux, uy = R20 + A * delta, R21 + Bq * delta
+    U = math.sqrt(ux * ux + uy * uy)
+    Z = y[2] + y[9] * delta - 0.5 * K * delta * delta
+    dth = 2.0 * math.pi / n
+    centre = math.atan2(uy, ux) + math.pi
+    if radius * U <= 0.0 or -Z / (radius * U) <= -1.0:
+        half = 0
+    else:
+        c = -Z / (radius * U)
+        W = math.pi if c >= 1.0 else math.pi - math.acos(c)
+        half = int(math.ceil(W / dth))
+    half = min(half + margin, n // 2)
+    return int(math.floor(centre / dth + 0.5)), half
+
+
+@njit(cache=True)
+def examine_window(y, acc, pts, n, K, B, k0, half, vnoise, res):
+    """Examine vertices k0 − half … k0 + half (mod n, each once), centre first then
+    outwards: the lowest usually bind the step, and a small step found early spares the
+    others their cubic."""
+    for j in range(min(2 * half + 1, n)):
+        off = (j + 1) // 2
+        k = (k0 - off if j % 2 else k0 + off) % n
+        examine(y, acc, True, pts, k, K, B, vnoise, res)
+
+
+@njit(cache=True)
+def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
+    ux, uy = px + x * qx, py + x * qy
+    return (
+        z + x * (vz - x * (0.5 * g + x * B / 6.0)) - math.sqrt(ux * ux + uy * uy) - 0.5 * x * x * rn
+    )
+
+
+@njit(cache=True)
+def circle_step(y, acc, g, radius, B):
+    """A step safe for every vertex at once, from the circle through them.
+
+    A vertex's P3 bound is linear in its body direction c: P3_c(δ) = Z3(δ) + c·u3(δ),
+    Z3 = z + v_z δ − g δ²/2 − B δ³/6, u3 = p + δ q + δ² r/2 with p, q, r the height,
+    rate and acceleration of the body points (a, 0), (0, a) less the centre's.  Over
+    |c| = 1, P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ²|r|/2, concave on δ ≥ 0, so its first
+    root is bracketed from below by chords and from above by Newton steps.  Returns (the
+    root within 1e-3 from below, F(0) = z − |p|, |p| = a sin α)."""
+    z, vz = y[2], y[9]
+    jx = point_jet(y, radius, 0.0, acc)
+    jy = point_jet(y, 0.0, radius, acc)
+    px, py = jx.gap - z, jy.gap - z
+    qx, qy = jx.rate - vz, jy.rate - vz
+    rn = math.sqrt((jx.accel - acc[2]) ** 2 + (jy.accel - acc[2]) ** 2)
+    pn = math.sqrt(px * px + py * py)
+    f0 = z - pn
+    if f0 <= 0.0:
+        return 0.0, f0, pn
+    lo, flo = 0.0, f0
+    hi = max(f0 / max(abs(vz) + math.sqrt(qx * qx + qy * qy), TINY), TINY)
+    for _ in range(2000):
+        fhi = _circle_F(hi, z, vz, g, B, px, py, qx, qy, rn)
+        if fhi < 0.0:
+            break
+        lo, flo = hi, fhi
+        hi *= 2.0
+    for _ in range(100):
+        if hi - lo <= 1e-3 * hi:
+            break
+        # the chord lies below F on [lo, hi] (concavity); the tangent at hi above it
+        ux, uy = px + hi * qx, py + hi * qy
+        un = math.sqrt(ux * ux + uy * uy)
+        d = vz - hi * (g + 0.5 * hi * B) - hi * rn
+        if un > 0.0:
+            d -= (ux * qx + uy * qy) / un
+        newton = hi - fhi / d if d < 0.0 else -1.0
+        for x in (lo + (hi - lo) * flo / (flo - fhi), newton):
+            if lo < x < hi:
+                fx = _circle_F(x, z, vz, g, B, px, py, qx, qy, rn)
+                if fx >= 0.0:
+                    lo, flo = x, fx
+                else:
+                    hi, fhi = x, fx
+    return lo, f0, pn
+
+
+@njit(cache=True)
+def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res):
+    """Examine the vertices near the lowest direction into res and return the cap on the
+    step they certify (inf when none is needed).  The touching/lowest vertices and
+    WINDOW_MAX more on each side come first; the step δ they allow holds for the others
+    if those outside window(δ) are safe by P2 and those inside have been examined: at
+    most WINDOW_MAX more are, δ being shortened (from 4× the last certified step) until
+    that suffices."""
+    k0, h0 = vertex_window(y, radius, n, K, 0.0, 2)
+    h = min(h0 + WINDOW_MAX, n // 2)
+    examine_window(y, acc, pts, n, K, B, k0, h, vnoise, res)
+    if res[HIT_K] >= 0 or res[LAND_K] >= 0 or 2 * h + 1 >= n:
+        return math.inf
+    dlt = min(res[STEP], left, 4.0 * last_dlt)
+    while True:
+        k1, h1 = vertex_window(y, radius, n, K, dlt, 3)
+        d = (k1 - k0) % n
+        if d > n // 2:
+            d -= n
+        lo1, hi1 = d - h1, d + h1
+        if 2 * h1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= WINDOW_MAX:
+            break
+        dlt *= 0.25
+    for off in range(h + 1, hi1 + 1):
+        examine(y, acc, True, pts, (k0 + off) % n, K, B, vnoise, res)
+    for off in range(lo1, -h):
+        examine(y, acc, True, pts, (k0 + off) % n, K, B, vnoise, res)
+    return dlt
+
+
+@njit(cache=True)
+def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
+    """One iteration's certified step (res holds hits and landings): every contact for
+    small n or the three-point ground, else the circle bound or the vertices near the
+    lowest direction.  Returns (step, last certified window step)."""
+    n = pts.shape[0]
+    K, B = bounds.K, bounds.B
+    res[STEP], res[HIT_DS], res[HIT_K], res[LAND_K] = math.inf, math.inf, -1.0, -1.0
+    if not windowed:
+        if model.flat_ground:
+            k0, _ = vertex_window(y, model.radius, n, K, 0.0, 0)
+            examine_window(y, acc, pts, n, K, B, k0, n // 2, vnoise, res)
+        else:
+            for k in range(n):
+                examine(y, acc, False, pts, k, K, B, vnoise, res)
+        return res[STEP], last_dlt
+    # far from the ground the circle through the vertices gives the step at once; within
+    # a few sags (a sin α (1 − cos π/n): the most a vertex sits above the circle's lowest
+    # point) of it, the vertices near the lowest direction are examined
+    d_c, f0, pn = circle_step(y, acc, model.gravity, model.radius, B)
+    sag = 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (abs(y[2]) + model.radius)
+    if f0 > sag:
+        return d_c, last_dlt
+    cap = near_vertices_step(y, acc, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
+    if cap < math.inf:
+        last_dlt = cap
+    return max(min(res[STEP], cap), d_c), last_dlt
+
+
+@njit(cache=True)
+def polish_impact(y0, fc, gravity, flat, pts, k, s_hit, y):
+    """Newton steps on contact k's gap from s_hit; y ends at the polished time, which is
+    returned."""
+    free_flight(y0, fc, gravity, s_hit, y)
+    for _ in range(POLISH_ITERATIONS):
+        acc = flight_acceleration(fc, y, gravity)
+        j = contact_jet(y, flat, pts, k, acc)
+        corr = -j.gap / j.rate
+        if not math.isfinite(corr) or abs(corr) <= POLISH_REL_TOL * max(abs(s_hit), TINY):
+            break
+        s_hit += corr
+        free_flight(y0, fc, gravity, s_hit, y)
+    return s_hit
+
+
+@njit(cache=True)
+def _candidates(y, model, pts, bounds, windowed):
+    """The contacts that can be at the ground now: (first, half) of an index range
+    around the lowest direction, every contact when half = n // 2."""
+    n = pts.shape[0]
+    if windowed:
+        return vertex_window(y, model.radius, n, bounds.K, 0.0, 3)
+    return 0, n // 2
+
+
+@njit(cache=True)
+def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together):
+    """Contacts reached with k0 at state y (k0 first): approaching, with a zero within
+    SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
+    flat = model.flat_ground
+    j0 = contact_jet(y, flat, pts, k0, acc)
+    tres0 = (j0.noise + TINY) / max(-j0.rate, TINY)
+    together[0] = k0
+    count = 1
+    n = pts.shape[0]
+    first, half = _candidates(y, model, pts, bounds, windowed)
+    for i in range(min(2 * half + 1, n)):
+        k = (first - half + i) % n
+        if k == k0:
+            continue
+        j = contact_jet(y, flat, pts, k, acc)
+        if j.rate >= -vnoise:
+            continue
+        if j.gap / -j.rate <= SIMULTANEOUS_FACTOR * ((j.noise + TINY) / max(-j.rate, TINY) + tres0):
+            together[count] = k
+            count += 1
+    return count
+
+
+@njit(cache=True)
+def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
+    """Contacts touching at rest and accelerating into the ground at state y."""
+    count = 0
+    n = pts.shape[0]
+    first, half = _candidates(y, model, pts, bounds, windowed)
+    for i in range(min(2 * half + 1, n)):
+        k = (first - half + i) % n
+        j = contact_jet(y, model.flat_ground, pts, k, acc)
+        if j.gap <= j.noise and j.rate <= vnoise and j.accel < 0:
+            together[count] = k
+            count += 1
+    return count
+
+
+@njit(cache=True)
+def find_flight_event(y0, fc, bounds, model, pts, window_search, horizon, max_iter, y, together):
+    """The first event of the free flight from y0 within `horizon`: FlightEvent with y at
+    its time (at the horizon when there is none) and the contacts reached in
+    together[:n_together]."""
+    n = pts.shape[0]
+    g = model.gravity
+    windowed = model.flat_ground and window_search and n > SMALL_N
+    y[:] = y0
+    s = 0.0
+    vnoise = (
+        RATE_NOISE_ULPS
+        * EPS
+        * (math.sqrt(y0[7] ** 2 + y0[8] ** 2 + y0[9] ** 2) + model.radius * fc.wabs)
+    )
+    res = np.empty(4)
+    last_dlt = math.inf
+    for it in range(max_iter):
+        acc = flight_acceleration(fc, y, g)
+        step, last_dlt = _search_step(
+            y, acc, model, pts, bounds, vnoise, windowed, horizon - s, last_dlt, res
+        )
+        if res[HIT_K] >= 0:
+            k = int(res[HIT_K])
+            s = polish_impact(y0, fc, g, model.flat_ground, pts, k, s + res[HIT_DS], y)
+            acc = flight_acceleration(fc, y, g)
+            m = collect_together(y, acc, model, pts, bounds, windowed, k, vnoise, together)
+            return FlightEvent(EVENT_IMPACT, s, k, m, it)
+        if res[LAND_K] >= 0:
+            m = collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together)
+            return FlightEvent(EVENT_ACTIVATION, s, together[0], m, it)
+        step = max(step, MIN_STEP_REL * max(s, TINY))
+        if s + step >= horizon:
+            free_flight(y0, fc, g, horizon, y)
+            return FlightEvent(EVENT_NONE, horizon, -1, 0, it)
+        s += step
+        free_flight(y0, fc, g, s, y)
+    return FlightEvent(EVENT_STUCK, s, -1, 0, max_iter)

@@ -1,0 +1,68 @@
+"""Named tolerances and factors of the exact reference, each with its reason.
+
+Plain module constants: the compiled functions read them as compile-time constants.
+"""
+
+EPS = 2.220446049250313e-16  # unit roundoff of a double
+# Guards divisions by quantities that may be exactly zero (a body at rest, a contact at
+# rest): x / max(y, TINY).  It is far below any physical value the inputs allow.
+TINY = 1e-300
+
+# Roundoff level of a gap, in ulps of the terms that form it: the gap z + r_z (or
+# (x − b)·e3) is a sum of a few products, each good to an ulp or two.
+GAP_NOISE_ULPS = 8.0
+# Roundoff level of a normal velocity, in ulps of the velocity scale V = |v| + a|ω|: it
+# is a sum of up to six products of velocities and levers.
+RATE_NOISE_ULPS = 64.0
+
+# A touch slower than GRAZE_FACTOR × √(2 g″ noise) cannot be told from a double root
+# (a graze): a convex gap reaches that speed inside its own roundoff band.
+GRAZE_FACTOR = 4.0
+# Two contacts whose zeros are within this many times the sum of their time resolutions
+# (noise / |rate|) are reached together: the model cannot order them (simultaneous).
+SIMULTANEOUS_FACTOR = 4.0
+
+# Derivative bounds K, B are enlarged by this factor (and by BOUND_ULPS·ε of their
+# terms) so that roundoff in forming them never makes them too small.
+BOUND_MARGIN = 1.0001
+BOUND_ULPS = 16.0
+# A safe step needs the first root of its lower bound only to this relative accuracy:
+# near a real contact the quadratic bound already gives the Newton-like step.
+ROOT_REL_TOL = 1e-3
+# The search always advances by at least this fraction of the elapsed time, so a contact
+# resting with g′ ≈ g″ ≈ 0 cannot stall it (it leaves at roundoff pace).
+MIN_STEP_REL = 1e-15
+# Newton polishing of an impact time: at most this many steps, stopping once the
+# correction is below POLISH_REL_TOL of the time.
+POLISH_ITERATIONS = 3
+POLISH_REL_TOL = 1e-16
+# Free-flight search iterations before the run is declared stuck.
+MAX_SEARCH_ITERATIONS = 100_000
+
+# Large polygons: for n > SMALL_N a search step examines only the vertices near the
+# lowest direction and WINDOW_MAX more on each side (reference.core.search).
+SMALL_N = 32
+WINDOW_MAX = 3
+
+# Chatter: a bounce lower than CHATTER_BOUNCE_FLOOR² roundoff bands of its gap (speed
+# below CHATTER_BOUNCE_FLOOR √(2 |a_n| noise)) cannot be resolved one impact at a time;
+# completion takes over (reference.core.chatter).
+CHATTER_BOUNCE_FLOOR = 100.0
+
+# Contact phases: the gap resolution is CONTACT_GAP_RES × rtol × the length scale (the
+# integrator resolves positions to ~rtol of the phase's size).
+CONTACT_GAP_RES = 16.0
+# Chunk horizon (reference.core.horizon): K = HORIZON_ACC_FACTOR max|g″| + g over the free
+# contacts; at most LOCAL_TIME_FRACTION of the local time scale √(L/K) and of the time
+# ROTATION_TIME_FACTOR·a/V the rim takes to move its own radius; a force falling at its
+# current rate may reach zero only after FORCE_TREND_FACTOR chunks of its current value.
+HORIZON_ACC_FACTOR = 2.0
+LOCAL_TIME_FRACTION = 0.25
+ROTATION_TIME_FACTOR = 2.0
+FORCE_TREND_FACTOR = 1.5
+# Two Gauss–Newton passes bring held gaps back to roundoff after a chunk.
+PROJECTION_PASSES = 2
+# Lift-off and crossing times inside a chunk: located to LOCATE_XTOL × the chunk length
+# (and 4 ε relative), at most LOCATE_ITERATIONS function evaluations.
+LOCATE_XTOL = 1e-15
+LOCATE_ITERATIONS = 200

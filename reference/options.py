@@ -1,0 +1,34 @@
+"""Settings of the exact reference that a user may change: sampling, tolerances and the
+search method.  Everything else is a named tolerance of the model
+(reference.core.tolerances)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class ReferenceOptions:
+    """How `reference.simulate` runs.
+
+    sample_dt: spacing of the regular samples (default t_end / 2000); events add their
+      own pre- and post-event samples.
+    chatter_tol: complete a chatter sequence once the separation speed u ≤ chatter_tol·V
+      (V = |v| + a|ω|); the completion changes the state by O(chatter_tol²) relative.
+    contact_rtol: relative tolerance of the DOP853 integration of contact phases.
+    energy_floor: the motion ends (singularity) once the energy above the resting level
+      is at most energy_floor × its initial value (18 decades by default; the exponent
+      fit of E ≈ a (t_f − t)^c then has 13 after skipping its first 3 and last 2).
+    max_samples: samples beyond this many are not recorded (the run goes on).
+    window_search: large polygons (n > 32) examine only the vertices near the ground at
+      each search step (False: every vertex; the same events, slower).
+    work_budget: loop steps between returns to Python (progress display, Ctrl-C).
+    """
+
+    sample_dt: float | None = None
+    chatter_tol: float = 1e-6
+    contact_rtol: float = 1e-12
+    energy_floor: float = 1e-18
+    max_samples: int = 500_000
+    window_search: bool = True
+    work_budget: int = 200_000

@@ -1,0 +1,77 @@
+"""The contact-phase integrator (reference.core.dop853) is scipy's DOP853: the same
+tableau, and on a held motion the same steps (right-hand-side evaluations) and end
+state as `solve_ivp(method="DOP853")` at the same tolerances."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+from scipy.integrate._ivp import dop853_coefficients as scipy_dop
+
+from reference import quaternion as qt
+from reference.core import dop853_tableau as tab
+from reference.core.contacts import vertex_lever
+from reference.core.dop853 import INT_DONE, integrate_held, new_stepper
+from reference.core.held import held_rhs, new_work
+from reference.core.output import Output
+from tests.conftest import core_model, make_scene
+
+
+def test_tableau_is_scipys():
+    n = scipy_dop.N_STAGES
+    assert tab.N_STAGES == n
+    np.testing.assert_array_equal(tab.A, scipy_dop.A[:n, :n])
+    np.testing.assert_array_equal(tab.B, scipy_dop.B)
+    np.testing.assert_array_equal(tab.C, scipy_dop.C[:n])
+    np.testing.assert_array_equal(tab.E3, scipy_dop.E3)
+    np.testing.assert_array_equal(tab.E5, scipy_dop.E5)
+
+
+def _held_state(two: bool):
+    """Vertex 0 (and 1 when `two`) of a pentagon on the ground at zero normal velocity,
+    the body rocking."""
+    y = np.zeros(13)
+    if two:
+        # rotate about the edge between vertices 0 and 1 so both are at the same height
+        edge = np.array([np.cos(0.4 * np.pi) - 1.0, np.sin(0.4 * np.pi), 0.0])
+        y[3:7] = qt.from_rotation_vector(0.2 * edge / np.linalg.norm(edge))
+        y[10:13] = [0.0, 0.0, 0.0]
+    else:
+        y[3:7] = qt.from_rotation_vector([0.02, 0.25, 0.1])
+        y[10:13] = [0.1, 1.2, 0.4]
+    rx, ry, rz = vertex_lever(y, 1.0, 0.0)
+    y[2] = -rz
+    y[9] = -(y[10] * ry - y[11] * rx)
+    return y
+
+
+@pytest.mark.parametrize("two", [False, True])
+def test_integration_is_scipys_dop853_step_for_step(two):
+    scene = make_scene(n=5, rho=0.45)
+    model, pts = core_model(scene)
+    idx = np.array([0, 1, 0]) if two else np.array([0, 0, 0])
+    m = 2 if two else 1
+    y0 = _held_state(two)
+    rtol = 1e-12
+    atol = np.full(13, 1e-14)
+    work = new_work()
+
+    def rhs(_t, y):
+        dy = np.empty(13)
+        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, work, dy)
+        return dy
+
+    ref = solve_ivp(rhs, (0.0, 0.3), y0, method="DOP853", rtol=rtol, atol=atol)
+    y = y0.copy()
+    out = Output(
+        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
+        np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
+    )  # fmt: skip
+    r = integrate_held(
+        y, 0.3, model, pts, idx, m, rtol, atol, new_work(), new_stepper(), np.zeros(0), 0,
+        out, (0.0, 0.0), 0, False,
+    )  # fmt: skip
+    assert r.status == INT_DONE
+    assert r.nfev == ref.nfev
+    np.testing.assert_allclose(y, ref.y[:, -1], rtol=0, atol=1e-13)

@@ -1,0 +1,114 @@
+"""The event search of the compiled core (reference.core.search): the state at the
+horizon, and the large-polygon window against every-vertex searches."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from harness.scenes import resolve_scene
+from reference import ReferenceOptions, simulate
+from reference import quaternion as qt
+from reference.core.flight import flight_bounds, flight_constants
+from reference.core.records import EVENT_IMPACT, EVENT_NONE
+from reference.core.search import find_flight_event
+from reference.geometry import initial_state
+from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
+from tests.conftest import core_model, flight, gaps
+from tests.oracle.body import BodyModel
+from tests.oracle.events import next_flight_event
+from tests.oracle.flight import flight_constants as oracle_flight_constants
+
+
+def test_final_sample_at_t_end_is_the_closed_form_state_there():
+    """With no contact reached before t_end the run ends with the closed-form state at
+    t_end, not at the search's last safe step."""
+    scene = resolve_scene("elastic-hexagon").with_run(t_end=0.05)  # no impact before 0.05
+    traj = simulate(scene)
+    assert len(traj.impacts) == 0 and traj.t[-1] == 0.05
+    exact = flight(scene, initial_state(scene.initial), 0.05)
+    assert qt.angle_between(traj.quaternion[-1], exact[3:7]) < 1e-14
+    assert np.max(np.abs(traj.position[-1] - exact[0:3])) < 1e-15
+
+
+def _polygon(n, initial, gamma=1.0, t_end=10.0, max_impacts=100_000):
+    return Scene(
+        name=f"n{n}",
+        body=Body(n=n, gyration=0.5),
+        ground=Ground(),
+        initial=initial,
+        restitution=gamma,
+        gravity=1.0,
+        run=RunSettings(t_end=t_end, max_impacts=max_impacts),
+    )
+
+
+def _random_flights(n: int, count: int, seed: int):
+    """n-gons in flight above flat ground: tilt from 1e-4 to 0.3 rad, spin about every
+    axis, the lowest vertex 1e-9 … 1e-2 above the ground, falling or rising."""
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        tilt = 10 ** rng.uniform(-4, np.log10(0.3))
+        az = rng.uniform(0, 2 * np.pi)
+        rotvec = (tilt * np.cos(az), tilt * np.sin(az), rng.uniform(-np.pi, np.pi))
+        scene = _polygon(
+            n,
+            InitialState(
+                position=(0.0, 0.0, float(np.sin(tilt) + 10 ** rng.uniform(-9, -2))),
+                rotation_vector=tuple(float(x) for x in rotvec),
+                velocity=(0.0, 0.0, float(rng.uniform(-0.5, 0.2))),
+                angular_velocity=tuple(float(x) for x in rng.normal(0, 0.5, 3)),
+            ),
+        )
+        y = initial_state(scene.initial)
+        if gaps(scene, y).min() > 0:
+            yield scene, y
+
+
+def _product_event(scene, y, window):
+    model, pts = core_model(scene)
+    fc = flight_constants(y, scene.body.inertia_diag[0], scene.body.inertia_diag[2])
+    bounds = flight_bounds(y, fc, model, pts, 10.0)
+    out, together = np.empty(13), np.empty(len(pts), dtype=np.int64)
+    ev = find_flight_event(y, fc, bounds, model, pts, window, 10.0, 100_000, out, together)
+    return ev, sorted(together[: ev.n_together].tolist())
+
+
+@pytest.mark.parametrize("n,count", [(33, 40), (100, 40), (1000, 20), (10_000, 6)])
+def test_large_n_window_search_finds_the_event_of_every_vertex_search(n, count):
+    """For n > 32 the search examines only a window of vertices near the lowest
+    direction and bounds the rest by the circle through them.  Against the same search
+    over every vertex, and against the oracle's (every vertex, the original derivative
+    bounds): the same first vertex, the same time to 1e-12."""
+    compared = 0
+    for scene, y in _random_flights(n, count, seed=n):
+        win, win_c = _product_event(scene, y, True)
+        full, full_c = _product_event(scene, y, False)
+        model = BodyModel.from_scene(scene)
+        orc = next_flight_event(model, oracle_flight_constants(model, y), 10.0)
+        assert (win.kind == EVENT_NONE) == (full.kind == EVENT_NONE) == (orc is None)
+        if orc is None:
+            continue
+        assert win.kind == full.kind == EVENT_IMPACT and orc.kind == "impact"
+        assert win_c == full_c == list(orc.contacts)
+        assert abs(win.s - orc.s) <= 1e-12 * max(1.0, orc.s)
+        assert abs(full.s - orc.s) <= 1e-12 * max(1.0, orc.s)
+        compared += 1
+    assert compared >= count // 2
+
+
+@pytest.mark.parametrize("n,n_compare", [(100, 20), (1000, 12), (10_000, 4)])
+def test_large_n_runs_agree_with_every_vertex_runs(n, n_compare):
+    """Whole bouncing runs (searches right after an impact, the impacting vertex and its
+    neighbours within roundoff of the ground): window search and every-vertex search give
+    the same impacts."""
+    scene = _polygon(
+        n, initial_from_linear((0.01, -0.004, 0.03), (0.03, 0.05, -0.2)), t_end=100.0,
+        max_impacts=n_compare,
+    )  # fmt: skip
+    win = simulate(scene)
+    full = simulate(scene, options=ReferenceOptions(window_search=False))
+    assert len(win.impacts) == len(full.impacts) == n_compare
+    for a, b in zip(win.impacts, full.impacts, strict=True):
+        assert a.contact == b.contact
+        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-12
