@@ -169,8 +169,8 @@ def bench(
     """Work-precision study of `scene` (module docstring).  Returns the contract's bench
     document plus `truth`, `skipped`, `derived`, `load` and the study's settings.
 
-    engines: simulators to sweep (default every installed engine, `engine_names()`); the reference at its
-    tightest setting is always run and timed, its looser settings only when
+    engines: simulators to sweep (default every installed engine, `engine_names()`); the
+    reference at its tightest setting is always run and timed, its looser settings only when
     "reference" is among `engines`.  dts: timesteps for the fixed-step engines (default
     `DEFAULT_DTS`).  budget_s: a setting whose predicted cost (repeats × predicted
     single-run time) exceeds it is skipped, and so are the finer timesteps after it.

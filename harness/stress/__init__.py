@@ -143,10 +143,11 @@ def stress(
     budget_s: float = DEFAULT_BUDGET_S,
 ) -> dict[str, Any]:
     """Run the hard cases (`--case` names or prefixes; default all) on the simulators
-    (default every installed engine, `engine_names()`; fixed-step engines at `dt`, default 1e-4) and judge each
-    run.  The reference always runs (it is the basis of missed/spurious impacts); its
-    row is listed when "reference" is requested.  Returns the contract's stress
-    document plus the settings, thresholds, case descriptions and the machine load."""
+    (default every installed engine, `engine_names()`; fixed-step engines at `dt`, default
+    1e-4) and judge each run.  The reference always runs (it is the basis of
+    missed/spurious impacts); its row is listed when "reference" is requested.  Returns
+    the contract's stress document plus the settings, thresholds, case descriptions and
+    the machine load."""
     say = progress or (lambda _msg: None)
     engines = list(dict.fromkeys(engines)) if engines else engine_names()
     for e in engines:
