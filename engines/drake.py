@@ -97,6 +97,9 @@ SAP_MAX_STEPS = 400
 CONTINUOUS_CONTACT_TIME = 1e-3
 # Continuous plant: the loosest target accuracy (at dt ≥ 1e-3 √(a/g)).
 CONTINUOUS_MAX_ACCURACY = 1e-3
+# The continuous profile's smallest restitution at the typical speed: γ = 0 is taken as
+# 0.01 (u = d v* = 100; Drake's guide calls d > 500 s/m unphysical and hard on solvers).
+HC_MIN_RESTITUTION = 0.01
 # A contact point this far below its ground (in body radii) has fallen through.
 FALL_THROUGH_DEPTH = FACE_HALF_THICKNESS_FRACTION
 
@@ -129,7 +132,7 @@ def hc_restitution(u: float) -> float:
     lo, hi = 0.0, min(1.0, 1.0 / u)
     for _ in range(200):  # bisection: f(e) = ln(1+u) − ln(1−eu) − u(1+e) rises through 0
         e = 0.5 * (lo + hi)
-        if math.log1p(u) - math.log1p(-e * u) - u * (1.0 + e) < 0.0:
+        if e * u < 1.0 and math.log1p(u) - math.log1p(-e * u) - u * (1.0 + e) < 0.0:
             lo = e
         else:
             hi = e
@@ -137,11 +140,11 @@ def hc_restitution(u: float) -> float:
 
 
 def hc_speed_factor(gamma: float) -> float:
-    """u = d·v giving restitution γ (`hc_restitution` inverted; e decreases with u)."""
+    """u = d·v giving restitution γ (`hc_restitution` inverted; e decreases with u).
+    γ is taken as at least HC_MIN_RESTITUTION (γ = 0 would need d = ∞)."""
     if gamma >= 1.0:
         return 0.0
-    if gamma <= 0.0:
-        return math.inf
+    gamma = max(gamma, HC_MIN_RESTITUTION)
     lo, hi = 0.0, 1.0
     while hc_restitution(hi) > gamma:
         hi *= 2.0
@@ -185,12 +188,16 @@ def sap_contact_steps(gamma: float) -> float:
 
 def sap_relaxation_time(gamma: float, steps: float) -> float:
     """τ/h with `sap_bounce`(N, τ/h) = γ at the middle onset phase (bisection; e falls
-    as τ grows); 0 when even τ = 0 bounces less than γ."""
+    as τ grows); 0 when even τ = 0 bounces less than γ.  At most critical damping,
+    τ = 2/ω₀ = 2N h/π (e = 0.14 there at N = 16): a stronger damper only makes the
+    contact creep (γ = 0 unbounded gave τ = 1700 h, and a resting disk still sinking
+    after 3000 steps)."""
+    critical = 2.0 * steps / math.pi
     if sap_bounce(steps, 0.0) <= gamma:
         return 0.0
-    lo, hi = 0.0, 1.0
-    while sap_bounce(steps, hi) > gamma and hi < 1e6:
-        hi *= 2.0
+    if sap_bounce(steps, critical) >= gamma:
+        return critical
+    lo, hi = 0.0, critical
     for _ in range(100):
         mid = 0.5 * (lo + hi)
         if sap_bounce(steps, mid) > gamma:
@@ -229,7 +236,7 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> DrakeSettings:
             profile=profile,
             time_step=0.0,
             stiffness=m_eff * (math.pi / (CONTINUOUS_CONTACT_TIME * unit)) ** 2,
-            hc_dissipation=(u / v_star) if math.isfinite(u) else 1e6,
+            hc_dissipation=u / v_star,
             relaxation_time=0.0,
             contact_steps=None,
             max_step=dt,
@@ -408,15 +415,19 @@ def simulate_drake(
     one row per step, impacts from contact onsets (engines.base).  Status `failed` (the
     run stops) on a non-finite state or when a contact point is FALL_THROUGH_DEPTH·a
     below its ground; stats: wall_time_s, steps, steps_per_s and the profile's parameters."""
-    from pydrake.systems.framework import EventStatus
-
     if profile not in PROFILES:
         raise ValueError(f"unknown Drake profile {profile!r}; choose from {', '.join(PROFILES)}")
     if not dt > 0:
         raise ValueError(f"dt must be > 0, got {dt}")
+    return run_with_settings(scene, contact_settings(scene, dt, profile), t_end)
+
+
+def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None = None):
+    """`simulate_drake` with explicit settings (the restitution study varies them)."""
+    from pydrake.systems.framework import EventStatus
+
     t_wall = time.perf_counter()
     t_end = scene.run.t_end if t_end is None else float(t_end)
-    settings = contact_settings(scene, dt, profile)
     model = build_model(scene, settings)
     y0 = initial_state(scene.initial)
     sim = _simulator(model, y0)
@@ -467,7 +478,7 @@ def simulate_drake(
         "wall_time_s": time.perf_counter() - t_wall,
         "steps": steps,
         "steps_per_s": steps / stepping if stepping > 0 else None,
-        "profile": profile,
+        "profile": settings.profile,
         "stiffness": settings.stiffness,
         "hc_dissipation": settings.hc_dissipation,
         "relaxation_time": settings.relaxation_time,
@@ -477,8 +488,9 @@ def simulate_drake(
         "restitution_model": settings.restitution_model,
         "drake_version": _drake_version(),
     }
+    dt = settings.time_step or settings.max_step
     return build_trajectory(
-        scene, ENGINE_NAMES[profile], dt, t, states, impulses, status, message, stats
+        scene, ENGINE_NAMES[settings.profile], dt, t, states, impulses, status, message, stats
     )
 
 
