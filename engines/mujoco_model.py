@@ -102,7 +102,8 @@ def tuned_contact(gamma: float, dt: float) -> ContactSettings:
     but at an onset the penetration r (|r| ≤ |vₙ| h, a random fraction of it) makes
     −h k r add up to k h²·|vₙ| to the bounce: a bias that does not shrink with h (with
     k = 1e-4/h², +1e-4 of the energy per impact on pentagon-bounce at every h from 1e-4
-    to 2e-6, measured; the 1e-3/h² of earlier notes is ten times worse; docs/engines.md compares both on six scenes).  Without it the
+    to 2e-6, measured; 1e-3/h² is ten times worse; docs/engines.md compares them on six
+    scenes).  Without it the
     penetration left by an onset stays (≤ |vₙ| h, the step's own error), and a resting
     contact sinks at (1 − d) g h/(1 + γ), i.e. 1e-4 g h² per step: 3e-8 over 3 s at
     h = 1e-4.  d = 1 − 1e-4 is MuJoCo's largest impedance (mjMAXIMP).  Measured with
