@@ -1,5 +1,14 @@
 """What every engine adapter shares: the impact sequence derived from contact activity,
-and assembly of a `Trajectory` in the reference's conventions.
+the scene's numbers an adapter needs (contact points, effective contact mass, a typical
+impact speed), the impact budget (`scene.run.max_impacts`) and assembly of a `Trajectory`
+in the reference's conventions.  An adapter for a new engine builds the scene's body and
+ground, steps it, and hands per-step states and contact impulses to `build_trajectory`
+(docs/engines.md; examples/toy-engine is a complete adapter in ~100 lines).
+
+State convention (the reference's, `reference.geometry`): rows of 13 numbers, centre of
+mass x (3), quaternion q = (w, x, y, z) body → world (4), velocity v (3) and angular
+velocity ω in the **world** frame (3).  The body frame is the principal frame: vertex k
+of a flat scene at a(cos 2πk/n, sin 2πk/n, 0), inertia m(ρa)² diag(1, 1, 2).
 
 Engines have no impact events.  An adapter records, per step and per contact point k,
 the normal impulse the engine applied (force × dt); a contact is *active* in a step when
@@ -20,12 +29,54 @@ inactive in the previous step.  Its
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from reference.geometry import energies
+from reference.geometry import contact_points, energies, excess_energy, initial_state
 from reference.geometry import scene_contact_kinematics as contact_kinematics
 from reference.scene import Scene
 from reference.trajectory import ImpactEvent, Status, Trajectory
+
+__all__ = [
+    "build_trajectory",
+    "contact_kinematics",
+    "contact_points",
+    "effective_contact_mass",
+    "energies",
+    "impacts_from_contact_activity",
+    "initial_state",
+    "scene_points",
+    "typical_impact_speed",
+]
+
+
+def scene_points(scene: Scene) -> np.ndarray:
+    """(k, 3) contact points of the scene: body-frame vertices (flat) or world-frame bump
+    centres (three_point), in the scene's contact numbering."""
+    return contact_points(scene.body, scene.ground)
+
+
+def effective_contact_mass(scene: Scene) -> float:
+    """Mass a unit normal impulse at one contact sees when the body lies flat:
+    1/m_eff = 1/m + |r × n|²/I₁ with |r × n| the lever arm (a for a vertex, b for a bump)
+    and I₁ = m(ρa)², i.e. m_eff = m/(1 + (r/(ρa))²) (the paper's η/g for a vertex).  For
+    the small tilts of these scenes the true value differs by O(α²)."""
+    b = scene.body
+    lever = b.radius if scene.ground.kind == "flat" else scene.ground.bump_radius
+    return b.mass / (1.0 + (lever / (b.gyration * b.radius)) ** 2)
+
+
+def typical_impact_speed(scene: Scene) -> float:
+    """A scale of the scene's impact speeds: √(E_x/(2 m_eff)), half the normal speed one
+    contact would reach if the whole excess energy E_x (above the resting level) went into
+    it.  On the built-in scenes (pentagon-bounce, triangle-chatter, three-point-disk,
+    elastic-hexagon) the first impacts come at 0.45–1.5 of this value; later ones are
+    slower, down to zero at the singularity.  √(g a) when the scene starts with no excess
+    energy."""
+    ex = float(excess_energy(scene, initial_state(scene.initial)[None])[0])
+    v = math.sqrt(0.5 * max(ex, 0.0) / effective_contact_mass(scene))
+    return v if v > 0 else math.sqrt(scene.gravity * scene.body.radius)
 
 
 def impacts_from_contact_activity(
@@ -45,8 +96,20 @@ def impacts_from_contact_activity(
     0.05 s, whichever is longer: soft default contacts last ~0.02 s); v⁺ is the largest
     normal velocity over the window and the row after it (engines book the impulse on
     the row before or after the step that applies it; the bounce peaks either way)."""
+    return [event for event, _ in _impact_windows(t, impulses, gaps, vn, max_impact_time)]
+
+
+def _impact_windows(
+    t: np.ndarray,
+    impulses: np.ndarray,
+    gaps: np.ndarray,
+    vn: np.ndarray,
+    max_impact_time: float | None = None,
+) -> list[tuple[ImpactEvent, int]]:
+    """`impacts_from_contact_activity` with, for each impact, the row where its v⁺ was
+    read (the end of the impact), sorted by time."""
     active = impulses > 0.0
-    events: list[ImpactEvent] = []
+    events: list[tuple[ImpactEvent, int]] = []
     n_steps, n_contacts = impulses.shape
     if n_steps == 0:
         return events
@@ -81,17 +144,27 @@ def impacts_from_contact_activity(
                 if r >= 0 and not active[r, k]:
                     pre_row = r
                     break
-            events.append(
-                ImpactEvent(
-                    t=float(tj),
-                    contact=int(k),
-                    impulse=float(total),
-                    v_normal_pre=float(vn[pre_row, k]),
-                    v_normal_post=float(vn[post_row, k]),
-                )
+            event = ImpactEvent(
+                t=float(tj),
+                contact=int(k),
+                impulse=float(total),
+                v_normal_pre=float(vn[pre_row, k]),
+                v_normal_post=float(vn[post_row, k]),
             )
-    events.sort(key=lambda e: (e.t, e.contact))
+            events.append((event, int(post_row)))
+    events.sort(key=lambda e: (e[0].t, e[0].contact))
     return events
+
+
+def impact_budget_end(windows: list[tuple[ImpactEvent, int]], max_impacts: int) -> int | None:
+    """Last row to keep when the run has more impacts than `max_impacts` (the end of the
+    max_impacts-th impact), None when the budget is not exhausted.  The reference stops
+    right after that impact with status max_impacts; engines are cut there the same way."""
+    if len(windows) <= max_impacts:
+        return None
+    if max_impacts == 0:
+        return 0
+    return max(row for _, row in windows[:max_impacts])
 
 
 def build_trajectory(
@@ -110,9 +183,18 @@ def build_trajectory(
 
     `states` (N, 13) in the reference's conventions (x, q wxyz, v, ω world) and
     `impulses` (N, k) are per step; samples keep every `sample_every`-th step (and the
-    last), impacts use every step."""
+    last), impacts use every step.  A run with more impacts than the scene's
+    `run.max_impacts` ends after the max_impacts-th one with status `max_impacts`
+    (`impact_budget_end`), as the reference does."""
     gaps, vns = contact_kinematics(scene, states)
-    impacts = impacts_from_contact_activity(t, impulses, gaps, vns)
+    windows = _impact_windows(t, impulses, gaps, vns)
+    end = impact_budget_end(windows, scene.run.max_impacts)
+    if end is not None:
+        n_kept = scene.run.max_impacts
+        t, states, gaps = t[: end + 1], states[: end + 1], gaps[: end + 1]
+        windows = windows[:n_kept]
+        status, message = Status.MAX_IMPACTS, f"reached max_impacts = {n_kept}"
+    impacts = [event for event, _ in windows]
     keep = np.arange(0, len(t), max(1, sample_every))
     if len(t) and keep[-1] != len(t) - 1:
         keep = np.append(keep, len(t) - 1)

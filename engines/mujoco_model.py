@@ -1,9 +1,10 @@
-"""MuJoCo model (MJCF) of a scene: the same body and ground as the reference, with the
-contact parameters of a profile.
+"""MuJoCo model of a scene, built with `mujoco.MjSpec` (MuJoCo's model-editing API, no
+formatted XML): the same body and ground as the reference, with the contact parameters
+of a profile.
 
-Geometry (DESIGN.md §4, ENGINE-NOTES "Geometry that is exactly a point contact"):
+Geometry (docs/engines.md, "Geometry that is exactly a point contact"):
 
-- body: one free body with `<inertial pos="0 0 0" mass=m diaginertia=m(ρa)²(1, 1, 2)>`,
+- body: one free body with explicit inertia (mass m at the origin, diagonal m(ρa)²(1, 1, 2)),
   so MuJoCo's body frame is the reference's principal body frame (no realignment);
 - `flat`: a sphere of radius r at each vertex a(cos 2πk/n, sin 2πk/n, 0) and the ground
   plane at z = −r.  Sphere–plane contact has the plane's normal ẑ and distance
@@ -15,7 +16,7 @@ Geometry (DESIGN.md §4, ENGINE-NOTES "Geometry that is exactly a point contact"
   reference's gap, for every tilt; the normal is the face normal e3 and the force acts on
   the line through b_k along e3 (the reference's line of action) exactly.
 
-Everything is frictionless (`condim="1"`: normal force only) and gravity is (0, 0, −g).
+Everything is frictionless (condim = 1: normal force only) and gravity is (0, 0, −g).
 """
 
 from __future__ import annotations
@@ -24,11 +25,15 @@ import math
 from dataclasses import dataclass
 
 import mujoco
-import numpy as np
 
 from reference.scene import Scene
 
+from .base import scene_points
+
 PROFILES = ("tuned", "default")
+# intprm[0] of a contact sensor: the bit set of its data fields; 2 = "force" (the MJCF
+# attribute data="force" compiles to it, read back from MjSpec.from_string).
+CONTACT_SENSOR_DATA_FORCE = 2
 
 # Contact sphere radius as a fraction of the body radius.  Any r gives the exact point
 # contact (see the module docstring); 1e-3 keeps the geoms' bounding boxes tight without
@@ -97,7 +102,8 @@ def tuned_contact(gamma: float, dt: float) -> ContactSettings:
     but at an onset the penetration r (|r| ≤ |vₙ| h, a random fraction of it) makes
     −h k r add up to k h²·|vₙ| to the bounce: a bias that does not shrink with h (with
     k = 1e-4/h², +1e-4 of the energy per impact on pentagon-bounce at every h from 1e-4
-    to 2e-6, measured; ENGINE-NOTES' 1e-3/h² is ten times worse).  Without it the
+    to 2e-6, measured; 1e-3/h² is ten times worse; docs/engines.md compares them on six
+    scenes).  Without it the
     penetration left by an onset stays (≤ |vₙ| h, the step's own error), and a resting
     contact sinks at (1 − d) g h/(1 + γ), i.e. 1e-4 g h² per step: 3e-8 over 3 s at
     h = 1e-4.  d = 1 − 1e-4 is MuJoCo's largest impedance (mjMAXIMP).  Measured with
@@ -182,79 +188,77 @@ def contact_geom_pairs(scene: Scene) -> list[tuple[str, str]]:
     return [(f"vertex{k}", "ground") for k in range(scene.body.n)]
 
 
-def _f(x: float) -> str:
-    """A float as MJCF text with all its digits."""
-    return repr(float(x))
+def _integrator(name: str | None) -> mujoco.mjtIntegrator:
+    """MuJoCo's integrator enum from its MJCF name (None: MuJoCo's default, Euler)."""
+    names = {
+        None: mujoco.mjtIntegrator.mjINT_EULER,
+        "Euler": mujoco.mjtIntegrator.mjINT_EULER,
+        "RK4": mujoco.mjtIntegrator.mjINT_RK4,
+        "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+        "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    }
+    return names[name]
 
 
-def _vec(xs) -> str:
-    return " ".join(_f(x) for x in xs)
-
-
-def build_mjcf(scene: Scene, dt: float, profile: str = "tuned") -> str:
-    """MJCF text of the scene under a profile, with one contact sensor per contact point
-    (normal force of contact k, so a rollout reports every contact force per step)."""
+def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec:
+    """The scene's model as an `mujoco.MjSpec` (MuJoCo's model-editing API) under a
+    profile, with one contact sensor per contact point (normal force of contact k, so a
+    rollout reports every contact force per step).  `spec.to_xml()` shows it as MJCF."""
     s = contact_settings(scene, dt, profile)
     a = scene.body.radius
     r = SPHERE_RADIUS_FRACTION * a
-    i1, i2, i3 = scene.body.inertia_diag
-
-    option = [f'timestep="{_f(dt)}"', f'gravity="0 0 {_f(-scene.gravity)}"']
-    if s.integrator is not None:
-        option.append(f'integrator="{s.integrator}"')
+    spec = mujoco.MjSpec()
+    spec.modelname = scene.name
+    spec.compiler.degree = False  # angles in radians (none are given)
+    spec.option.timestep = dt
+    spec.option.gravity = [0.0, 0.0, -scene.gravity]
+    spec.option.integrator = _integrator(s.integrator)
     if s.tolerance is not None:
-        option.append(f'tolerance="{_f(s.tolerance)}"')
-    flag = '<flag diagexact="enable"/>' if s.diagexact else ""
+        spec.option.tolerance = s.tolerance
+    if s.diagexact:
+        spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_DIAGEXACT
 
-    geom_default = ['condim="1"']
-    if s.solref is not None:
-        geom_default.append(f'solref="{_vec(s.solref)}"')
-    if s.solimp is not None:
-        geom_default.append(f'solimp="{_vec(s.solimp)}"')
+    def contact_geom(parent, name, **attributes):
+        geom = parent.add_geom(name=name, condim=1, **attributes)  # frictionless
+        if s.solref is not None:
+            geom.solref = list(s.solref)
+        if s.solimp is not None:
+            geom.solimp = list(s.solimp)
+        return geom
 
-    world: list[str] = []
-    body: list[str] = []
+    world = spec.worldbody
+    body = world.add_body(name="body")
+    body.add_freejoint(name="free")
+    body.explicitinertial = True  # the inertia below, not the geoms' (principal frame)
+    body.mass = scene.body.mass
+    body.ipos = [0.0, 0.0, 0.0]
+    body.inertia = list(scene.body.inertia_diag)
+    sphere, points = mujoco.mjtGeom.mjGEOM_SPHERE, scene_points(scene)
     if scene.ground.kind == "three_point":
-        b = scene.ground.bump_radius
-        for k in range(3):
-            ang = 2.0 * math.pi * k / 3.0
-            pos = (b * math.cos(ang), b * math.sin(ang), 0.0)
-            world.append(f'<geom name="bump{k}" type="sphere" size="{_f(r)}" pos="{_vec(pos)}"/>')
+        for k, p in enumerate(points):
+            contact_geom(world, f"bump{k}", type=sphere, size=[r, 0, 0], pos=list(p))
         hh = FACE_HALF_THICKNESS_FRACTION * a
-        body.append(
-            f'<geom name="face" type="cylinder" size="{_f(a)} {_f(hh)}" pos="0 0 {_f(r + hh)}"/>'
+        contact_geom(
+            body, "face", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[a, hh, 0], pos=[0, 0, r + hh]
         )
     else:
-        world.append(f'<geom name="ground" type="plane" size="0 0 1" pos="0 0 {_f(-r)}"/>')
-        n = scene.body.n
-        for k in range(n):
-            ang = 2.0 * np.pi * k / n  # same expression as reference.body.BodyModel
-            pos = (a * np.cos(ang), a * np.sin(ang), 0.0)
-            body.append(f'<geom name="vertex{k}" type="sphere" size="{_f(r)}" pos="{_vec(pos)}"/>')
-
-    sensors = "\n    ".join(
-        f'<contact name="force{k}" geom1="{g1}" geom2="{g2}" data="force" num="1"/>'
-        for k, (g1, g2) in enumerate(contact_geom_pairs(scene))
-    )
-    nl = "\n    "
-    return f"""<mujoco model="{scene.name}">
-  <compiler angle="radian"/>
-  <option {" ".join(option)}>{flag}</option>
-  <default><geom {" ".join(geom_default)}/></default>
-  <worldbody>
-    {nl.join(world)}
-    <body name="body">
-      <freejoint name="free"/>
-      <inertial pos="0 0 0" mass="{_f(scene.body.mass)}" diaginertia="{_vec((i1, i2, i3))}"/>
-      {nl.join("  " + g for g in body)}
-    </body>
-  </worldbody>
-  <sensor>
-    {sensors}
-  </sensor>
-</mujoco>
-"""
+        plane = mujoco.mjtGeom.mjGEOM_PLANE
+        contact_geom(world, "ground", type=plane, size=[0, 0, 1], pos=[0, 0, -r])
+        for k, p in enumerate(points):
+            contact_geom(body, f"vertex{k}", type=sphere, size=[r, 0, 0], pos=list(p))
+    for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
+        spec.add_sensor(
+            name=f"force{k}",
+            type=mujoco.mjtSensor.mjSENS_CONTACT,
+            objtype=mujoco.mjtObj.mjOBJ_GEOM,
+            objname=g1,
+            reftype=mujoco.mjtObj.mjOBJ_GEOM,
+            refname=g2,
+            # MJCF <contact data="force" num="1">: data bit 2 (force), no reduction, 1 slot
+            intprm=[CONTACT_SENSOR_DATA_FORCE, 0, 1],
+        )
+    return spec
 
 
 def load_model(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjModel:
-    return mujoco.MjModel.from_xml_string(build_mjcf(scene, dt, profile))
+    return build_spec(scene, dt, profile).compile()

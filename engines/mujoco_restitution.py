@@ -22,54 +22,16 @@ Measured (mujoco 4.0.0, v0 = 1, θ = 0.1, g = a = 1):
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 
 import numpy as np
 
-from reference.scene import Scene, scene_from_dict
-
-from .base import contact_kinematics
+from .drop import effective_restitution, single_vertex_drop
 from .mujoco import simulate_mujoco
 
 GAMMAS = (0.3, 0.5, 0.8, 0.95)
 TIMESTEPS = (1e-3, 1e-4, 1e-5)
-
-
-def single_vertex_drop(
-    gamma: float, theta: float = 0.1, v0: float = 1.0, h0: float = 0.01, t_end: float = 0.06
-) -> Scene:
-    return scene_from_dict(
-        {
-            "name": f"single-vertex-drop-{gamma:g}",
-            "gravity": 1.0,
-            "restitution": gamma,
-            "body": {"n": 5, "radius": 1.0, "mass": 1.0, "gyration": 0.5},
-            "ground": {"kind": "flat"},
-            "initial": {
-                "position": [0.0, 0.0, math.sin(theta) + h0],
-                "rotation_vector": [0.0, theta, 0.0],
-                "velocity": [0.0, 0.0, -v0],
-                "angular_velocity": [0.0, 0.0, 0.0],
-            },
-            "run": {"t_end": t_end},
-        }
-    )
-
-
-def effective_restitution(scene: Scene, states: np.ndarray, k: int = 0) -> float:
-    """−vₙ(after)/vₙ(before) of contact k around its first contact; nan if it never
-    touches, 0 if it never leaves."""
-    gap, vn = contact_kinematics(scene, states)
-    down = np.flatnonzero(gap[:, k] <= 0.0)
-    if not down.size or down[0] == 0:
-        return math.nan
-    j0 = int(down[0])
-    up = np.flatnonzero(gap[j0:, k] > 0.0)
-    if not up.size:
-        return 0.0
-    return float(-vn[j0 + int(up[0]), k] / vn[j0 - 1, k])
 
 
 def measure(gamma: float, dt: float, profile: str) -> float:

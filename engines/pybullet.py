@@ -1,7 +1,7 @@
 """PyBullet model of a scene: the same body and ground, frictionless point contacts,
 run at a fixed step and returned as a `Trajectory` in the reference's conventions.
 
-Geometry (DESIGN.md §4, ENGINE-NOTES "Geometry that is exactly a point contact"):
+Geometry (DESIGN.md §4, docs/engines.md "Geometry that is exactly a point contact"):
 
 - `flat`: one `<collision><sphere>` of radius r at every vertex, in a URDF (the
   collision-shape-array API keeps only 16 shapes), and the ground plane lowered by r.
@@ -21,7 +21,7 @@ body never sleeps.
 
 Profiles (how γ maps to the engine):
 
-- `tuned` (engine name "pybullet"): the settings of ENGINE-NOTES that make a vertex
+- `tuned` (engine name "pybullet"): the settings (docs/engines.md) that make a vertex
   impact Newtonian with coefficient γ; each value is explained where it is set.
 - `default` ("pybullet-default"): what a typical user writes: the same body with
   restitution set on it (pair restitution γ, see `_restitutions`) and otherwise the
@@ -69,7 +69,7 @@ PROFILES = ("tuned", "default")
 ENGINE_NAMES = {"tuned": "pybullet", "default": "pybullet-default"}
 
 # Radius of the contact spheres relative to the body radius a.  Any value from 1e-2 to
-# 1e-6 gave the same impacts (ENGINE-NOTES); it must be small against a so the
+# 1e-6 gave the same impacts (docs/engines.md); it must be small against a so the
 # three_point distance error r(1 − cos α) and the mapping of points to vertices are
 # negligible, and large against roundoff of the positions (1e-16 a).
 SPHERE_RADIUS = 1e-3

@@ -41,7 +41,7 @@ from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
 from ..metrics import evaluate
-from ..simulators import ENGINES, FIXED_STEP, check_engine, run_simulator
+from ..simulators import check_engine, engine_names, is_fixed_step, run_simulator
 from ..text import table
 
 DEFAULT_DTS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6)
@@ -169,8 +169,8 @@ def bench(
     """Work-precision study of `scene` (module docstring).  Returns the contract's bench
     document plus `truth`, `skipped`, `derived`, `load` and the study's settings.
 
-    engines: simulators to sweep (default all of `ENGINES`); the reference at its
-    tightest setting is always run and timed, its looser settings only when
+    engines: simulators to sweep (default every installed engine, `engine_names()`); the
+    reference at its tightest setting is always run and timed, its looser settings only when
     "reference" is among `engines`.  dts: timesteps for the fixed-step engines (default
     `DEFAULT_DTS`).  budget_s: a setting whose predicted cost (repeats × predicted
     single-run time) exceeds it is skipped, and so are the finer timesteps after it.
@@ -178,7 +178,7 @@ def bench(
     say = progress or (lambda _msg: None)
     if repeats < 1:
         raise SceneError(f"--repeats must be >= 1, got {repeats}")
-    engines = list(engines) if engines else list(ENGINES)
+    engines = list(engines) if engines else engine_names()
     for e in engines:
         check_engine(e)
     dts = sorted({float(d) for d in (dts or DEFAULT_DTS)}, reverse=True)
@@ -222,7 +222,7 @@ def bench(
         if engine == "reference":
             for rc in ref_settings:
                 measure(reference_setting(rc))
-        elif engine not in FIXED_STEP:
+        elif not is_fixed_step(engine):
             setting = Setting(engine)
             timed(setting, scene, horizon)  # warm-up (e.g. numba compilation)
             measure(setting)
@@ -365,7 +365,7 @@ def derive(rows: list[dict[str, Any]]) -> dict[str, Any]:
             if not front:
                 continue
             ts, es = [p[0] for p in front], [p[1] for p in front]
-            if len(front) == 1 and engine not in FIXED_STEP:
+            if len(front) == 1 and not is_fixed_step(engine):
                 err, bound = es[0], "single setting"
             elif t_ref < ts[0]:
                 err, bound = None, "none"

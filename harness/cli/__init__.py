@@ -14,10 +14,10 @@ import traceback
 
 from reference.scene import SceneError
 
-from . import analyze, bench, compare, figures, scenes, simulate, stress, sweep
+from . import analyze, bench, compare, engines, figures, scenes, simulate, stress, sweep
 from .common import BadInput, Parser
 
-COMMANDS = (scenes, simulate, compare, bench, stress, analyze, sweep, figures)
+COMMANDS = (scenes, engines, simulate, compare, bench, stress, analyze, sweep, figures)
 
 
 def build_parser() -> Parser:

@@ -26,7 +26,7 @@ from ..metrics import (
     effective_restitution,
     evaluate,
 )
-from ..simulators import DEFAULT_DT, FIXED_STEP, run_simulator
+from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator
 from ..text import table
 
 
@@ -91,7 +91,7 @@ def compare(
     say(_progress_line("reference", None, reference, ref_wall))
     runs: list[EngineRun] = []
     for engine in engines:
-        for dt in dts if engine in FIXED_STEP else [None]:
+        for dt in dts if is_fixed_step(engine) else [None]:
             if engine == "reference":
                 traj, wall = reference, ref_wall
             else:

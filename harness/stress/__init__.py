@@ -44,7 +44,7 @@ from typing import Any
 from reference.scene import SceneError
 from reference.trajectory import Trajectory
 
-from ..simulators import DEFAULT_DT, ENGINES, FIXED_STEP, check_engine, run_simulator
+from ..simulators import DEFAULT_DT, check_engine, engine_names, is_fixed_step, run_simulator
 from .budget import (
     HARD_CAP_FACTOR,
     over_budget,
@@ -93,7 +93,7 @@ def _engine_row(
     """Run one non-reference simulator on a case (unless predicted over the budget) and
     judge it against the reference run `ref` (a prefix of the case if `ref_partial`)."""
     scene, t_end = case.scene, case.scene.run.t_end
-    step = dt if engine in FIXED_STEP else None
+    step = dt if is_fixed_step(engine) else None
     predicted = None
     if step is not None:
         try:
@@ -143,12 +143,13 @@ def stress(
     budget_s: float = DEFAULT_BUDGET_S,
 ) -> dict[str, Any]:
     """Run the hard cases (`--case` names or prefixes; default all) on the simulators
-    (default all of `ENGINES`; fixed-step engines at `dt`, default 1e-4) and judge each
-    run.  The reference always runs (it is the basis of missed/spurious impacts); its
-    row is listed when "reference" is requested.  Returns the contract's stress
-    document plus the settings, thresholds, case descriptions and the machine load."""
+    (default every installed engine, `engine_names()`; fixed-step engines at `dt`, default
+    1e-4) and judge each run.  The reference always runs (it is the basis of
+    missed/spurious impacts); its row is listed when "reference" is requested.  Returns
+    the contract's stress document plus the settings, thresholds, case descriptions and
+    the machine load."""
     say = progress or (lambda _msg: None)
-    engines = list(dict.fromkeys(engines)) if engines else list(ENGINES)
+    engines = list(dict.fromkeys(engines)) if engines else engine_names()
     for e in engines:
         check_engine(e)
     dt = float(dt) if dt is not None else DEFAULT_DT

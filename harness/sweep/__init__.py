@@ -24,7 +24,7 @@ from pathlib import Path
 
 from reference.scene import SceneError
 
-from ..simulators import ENGINES, FIXED_STEP
+from ..simulators import check_engine, is_fixed_step
 from .executors import ExecutorError
 from .grid import (
     SweepConfig,
@@ -47,8 +47,7 @@ def _bad(msg: str) -> SweepError:
 
 def config_from_args(args) -> SweepConfig:
     """Validate the CLI arguments into a SweepConfig (BadInput on nonsense)."""
-    if args.engine not in ENGINES:
-        raise _bad(f"unknown engine {args.engine!r}; choose from {', '.join(ENGINES)}")
+    check_engine(args.engine)
     if args.n < 2:
         raise _bad(f"--n must be >= 2, got {args.n}")
     if args.samples < 1:
@@ -69,7 +68,7 @@ def config_from_args(args) -> SweepConfig:
         samples=int(args.samples),
         seed=int(args.seed),
         engine=args.engine,
-        dt=float(dt) if (dt is not None and args.engine in FIXED_STEP) else None,
+        dt=float(dt) if (dt is not None and is_fixed_step(args.engine)) else None,
         min_decades=default_min_decades(args.engine),
         **extra,
     )

@@ -232,10 +232,10 @@ def fixed_step_t_end(config: SweepConfig, rho: float, gamma: float, q0, p0) -> f
 
 
 def run_trajectory_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) -> dict:
-    from ..simulators import FIXED_STEP, run_simulator
+    from ..simulators import is_fixed_step, run_simulator
 
     t_end = config.t_end
-    if config.engine in FIXED_STEP:
+    if is_fixed_step(config.engine):
         t_end = min(t_end, fixed_step_t_end(config, rho, gamma, q0, p0))
     scene = polygon_scene(config, rho, gamma, q0, p0)
     traj = run_simulator(config.engine, scene, dt=config.dt, t_end=t_end)

@@ -1,0 +1,98 @@
+"""The entry points of the engines this package ships (group `harness.engines`, registered
+in pyproject.toml like any third-party engine; docs/engines.md).
+
+This module imports nothing heavy: each callable imports its engine when it runs, so that
+listing the engines or running the reference never imports MuJoCo, PyBullet or Drake.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+
+from reference.scene import Scene
+from reference.trajectory import Trajectory
+
+
+def engine_entry(
+    fixed_step: bool = True, library: str | None = None
+) -> Callable[[Callable], Callable]:
+    """Mark a `simulate(scene, *, dt, t_end)` callable as an engine entry point; `library`
+    names the distribution of the physics engine it wraps (shown by `harness engines`)."""
+
+    def mark(fn: Callable) -> Callable:
+        fn.fixed_step = fixed_step
+        if library is not None:
+            fn.library = library
+        return fn
+
+    return mark
+
+
+def _profile(module: str, function: str, profile: str, library: str, doc: str) -> Callable:
+    """An entry point that runs `module.function(scene, dt, t_end=…, profile=…)`."""
+
+    @engine_entry(fixed_step=True, library=library)
+    def simulate(scene: Scene, *, dt: float, t_end: float | None = None) -> Trajectory:
+        run = getattr(importlib.import_module(module), function)
+        return run(scene, dt, t_end=t_end, profile=profile)
+
+    simulate.__doc__ = doc
+    simulate.__qualname__ = simulate.__name__ = f"{function}[{profile}]"
+    return simulate
+
+
+@engine_entry(fixed_step=False)
+def reference(scene: Scene, *, dt: float | None = None, t_end: float | None = None) -> Trajectory:
+    """The exact event-driven reference (dt does not apply)."""
+    from reference.simulate import simulate
+
+    return simulate(scene, t_end=t_end)
+
+
+@engine_entry(fixed_step=False)
+def linear(scene: Scene, *, dt: float | None = None, t_end: float | None = None) -> Trajectory:
+    """The paper's linear model, exact event-driven (dt does not apply)."""
+    from reference.linear.simulate import simulate_linear
+
+    return simulate_linear(scene, t_end=t_end)
+
+
+mujoco = _profile(
+    "engines.mujoco",
+    "simulate_mujoco",
+    "tuned",
+    "mujoco",
+    "MuJoCo, tuned contact (engines/mujoco_model.py)",
+)
+mujoco_default = _profile(
+    "engines.mujoco",
+    "simulate_mujoco",
+    "default",
+    "mujoco",
+    "MuJoCo, defaults + documented dampratio",
+)
+pybullet = _profile(
+    "engines.pybullet",
+    "simulate_pybullet",
+    "tuned",
+    "pybullet",
+    "PyBullet, tuned split-impulse contact",
+)
+pybullet_default = _profile(
+    "engines.pybullet",
+    "simulate_pybullet",
+    "default",
+    "pybullet",
+    "PyBullet, defaults + restitution",
+)
+drake = _profile(
+    "engines.drake", "simulate_drake", "sap", "drake", "Drake, discrete plant with the SAP solver"
+)
+drake_continuous = _profile(
+    "engines.drake",
+    "simulate_drake",
+    "continuous",
+    "drake",
+    "Drake, continuous plant, error-controlled RK3 (dt = its maximum step)",
+)

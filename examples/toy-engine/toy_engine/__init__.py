@@ -1,0 +1,97 @@
+"""A toy engine for the Euler's disk harness: rigid body, semi-implicit Euler, and at
+every vertex a one-step velocity projection (Newton's law vₙ⁺ = −γ vₙ⁻ on contacts that
+penetrate and approach, solved one contact at a time, Gauss–Seidel).
+
+It shows what an engine adapter does: build the scene's body (from the harness's
+`engines.base` helpers), step it, and hand per-step states (reference conventions: x,
+q wxyz, v, ω world) and per-contact normal impulses to `build_trajectory`, which finds the
+impacts (contact onsets), energies and the impact budget.  Flat ground only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engines.base import build_trajectory, initial_state, scene_points
+from reference.scene import Scene, SceneError
+from reference.trajectory import Status, Trajectory
+
+__version__ = "0.1.0"
+GAUSS_SEIDEL_SWEEPS = 4  # resting n-gons need a few sweeps to share the load
+
+
+def _rotation(q):
+    w, x, y, z = q
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def _rotate_by(q, phi):
+    """exp(φ/2) ⊗ q: q turned by the world rotation vector φ."""
+    th = np.sqrt(phi @ phi)
+    s = np.sinc(th / (2 * np.pi)) / 2  # sin(θ/2)/θ
+    a0, (a1, a2, a3) = np.cos(th / 2), s * phi
+    b0, b1, b2, b3 = q
+    out = np.array(
+        [
+            a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+            a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+            a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+            a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+        ]
+    )
+    return out / np.sqrt(out @ out)
+
+
+def _step(y, dt, g, m, inertia, points, gamma):
+    """One semi-implicit Euler step: gravity, gyroscopic torque, contact impulses from the
+    state at the start of the step, then positions from the new velocities."""
+    x, q, v, w = y[0:3], y[3:7], y[7:10].copy(), y[10:13].copy()
+    R = _rotation(q)
+    I_inv = R @ np.diag(1.0 / inertia) @ R.T  # world-frame inverse inertia
+    v[2] -= g * dt
+    w = w - dt * I_inv @ np.cross(w, R @ (inertia * (R.T @ w)))  # Euler's equations
+    r = points @ R.T  # lever arms in the world
+    impulses = np.zeros(len(points))
+    touching = np.flatnonzero(x[2] + r[:, 2] <= 0.0)
+    arms = np.cross(r[touching], [0.0, 0.0, 1.0])  # (r × ẑ): vₙ = v_z + arm·ω
+    targets = -gamma * np.minimum(v[2] + arms @ w, 0.0)  # Newton: vₙ⁺ = −γ vₙ⁻
+    k_inv = 1.0 / m + np.einsum("ij,jk,ik->i", arms, I_inv, arms)  # 1/m_eff per contact
+    for _ in range(GAUSS_SEIDEL_SWEEPS):
+        for i, k in enumerate(touching):
+            vn = v[2] + arms[i] @ w
+            p = max(-impulses[k], (targets[i] - vn) / k_inv[i])  # total impulse ≥ 0
+            impulses[k] += p
+            v[2] += p / m
+            w = w + I_inv @ arms[i] * p
+    return np.concatenate([x + dt * v, _rotate_by(q, w * dt), v, w]), impulses
+
+
+def simulate(scene: Scene, *, dt: float, t_end: float | None = None) -> Trajectory:
+    """The entry point: `harness` calls it with the scene, the step and the end time."""
+    if scene.ground.kind != "flat":
+        raise SceneError("the toy engine models flat ground only")
+    t_end = scene.run.t_end if t_end is None else float(t_end)
+    n = max(1, int(round(t_end / dt)))
+    points = scene_points(scene)
+    inertia = np.array(scene.body.inertia_diag)
+    states = np.empty((n + 1, 13))
+    impulses = np.zeros((n + 1, len(points)))
+    states[0] = initial_state(scene.initial)
+    for j in range(n):
+        states[j + 1], impulses[j + 1] = _step(
+            states[j], dt, scene.gravity, scene.body.mass, inertia, points, scene.restitution
+        )
+    t = dt * np.arange(n + 1)
+    stats = {"steps": n, "toy_engine_version": __version__}
+    return build_trajectory(
+        scene, "toy", dt, t, states, impulses, Status.T_END, f"reached t_end = {t_end:g}", stats
+    )
+
+
+simulate.fixed_step = True  # --dt applies

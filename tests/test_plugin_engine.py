@@ -1,0 +1,118 @@
+"""Engines from other packages: the entry-point registry finds them, `harness engines`
+lists them, `harness compare` runs them, and a broken or missing one is bad input (exit
+2, its name and the reason, no traceback).  Listing and the reference import no engine.
+
+The default tests put a hand-made dist-info (what pip writes) on sys.path; the slow test
+installs examples/toy-engine with pip into a temporary directory."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from harness import simulators
+from harness.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+TOY = ROOT / "examples" / "toy-engine"
+
+
+def _dist_info(where: Path, name: str, version: str, entry_points: str) -> None:
+    info = where / f"{name.replace('-', '_')}-{version}.dist-info"
+    info.mkdir(parents=True)
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name}\nVersion: {version}\n")
+    (info / "entry_points.txt").write_text(f"[harness.engines]\n{entry_points}\n")
+
+
+@pytest.fixture
+def plugins(tmp_path, monkeypatch):
+    """The toy engine (its source directory) and a broken engine, installed as
+    distributions on sys.path for this test only."""
+    _dist_info(tmp_path, "harness-toy-engine", "0.1.0", "toy = toy_engine:simulate")
+    _dist_info(tmp_path, "broken-engine", "9.9", "broken = broken_engine:simulate")
+    (tmp_path / "broken_engine.py").write_text("raise ImportError('needs libfoo.so')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.syspath_prepend(str(TOY))
+    simulators.refresh()
+    yield tmp_path
+    simulators.refresh()
+
+
+def test_an_installed_engine_is_discovered_with_its_package(plugins):
+    assert "toy" in simulators.engine_names()
+    info = {i.name: i for i in simulators.engine_infos()}["toy"]
+    assert (info.package, info.version) == ("harness-toy-engine", "0.1.0")
+    assert simulators.is_fixed_step("toy")
+
+
+def test_harness_engines_lists_the_plugin_and_names_the_broken_one(plugins, capsys):
+    assert main(["engines", "--json"]) == 2  # one engine fails to load
+    out, err = capsys.readouterr()
+    rows = {r["name"]: r for r in json.loads(out)["engines"]}
+    assert rows["toy"]["package"] == "harness-toy-engine" and rows["toy"]["error"] is None
+    assert rows["reference"]["fixed_step"] is False and rows["mujoco"]["fixed_step"] is True
+    assert "broken" in err and "needs libfoo.so" in err and "Traceback" not in err
+
+
+def test_compare_runs_the_plugin_against_the_reference(plugins, capsys):
+    code = main(
+        ["compare", "pentagon-bounce", "--engine", "toy", "--dt", "1e-3", "--t-end", "0.5"]
+        + ["--json"]
+    )
+    assert code == 0
+    run = json.loads(capsys.readouterr().out)["engines"][0]
+    assert run["engine"] == "toy" and run["status"] == "t_end"
+    # the toy's Newton impacts come in the reference's order (the first 4, t < 0.5)
+    assert run["impacts_matched"] >= 4
+
+
+@pytest.mark.parametrize(
+    "engine, reason", [("broken", "needs libfoo.so"), ("not-installed", "unknown engine")]
+)
+def test_a_broken_or_missing_engine_is_bad_input(plugins, capsys, engine, reason):
+    assert main(["compare", "pentagon-bounce", "--engine", engine]) == 2
+    err = capsys.readouterr().err
+    assert engine in err and reason in err and "Traceback" not in err
+
+
+def test_listing_engines_and_running_the_reference_import_no_physics_engine():
+    code = (
+        "import sys\n"
+        "from harness.cli import main\n"
+        "assert main(['engines']) == 0\n"
+        "assert main(['simulate', 'pentagon-bounce', '--t-end', '0.3']) == 0\n"
+        "heavy = [m for m in ('mujoco', 'pybullet', 'pydrake') if m in sys.modules]\n"
+        "assert not heavy, heavy\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, cwd=ROOT)
+
+
+@pytest.mark.slow
+def test_pip_installed_plugin_appears_and_runs_without_changing_this_package(tmp_path):
+    """pip install --target (build isolation fetches setuptools: ~20 s with network)."""
+    target = tmp_path / "site"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target)]
+        + [str(TOY)],
+        check=True,
+        capture_output=True,
+    )
+    env = {**os.environ, "PYTHONPATH": str(target)}
+    harness = [sys.executable, "-m", "harness"]
+    listed = subprocess.run(harness + ["engines", "--json"], env=env, capture_output=True)
+    rows = {r["name"]: r for r in json.loads(listed.stdout)["engines"]}
+    assert rows["toy"]["package"] == "harness-toy-engine" and listed.returncode == 0
+    compared = subprocess.run(
+        harness
+        + ["compare", "pentagon-bounce", "--engine", "toy", "--dt", "1e-3"]
+        + ["--t-end", "0.5", "--json"],
+        env=env,
+        capture_output=True,
+    )
+    assert compared.returncode == 0, compared.stderr.decode()
+    assert json.loads(compared.stdout)["engines"][0]["impacts_matched"] >= 4
