@@ -30,4 +30,12 @@ def resolve_scene(arg: str) -> Scene:
 
 
 def list_builtin() -> list[tuple[str, str]]:
-    return [(name, resolve_scene(name).description) for name in builtin_names()]
+    """(name, description) of every built-in scene, read from the files without building
+    the scenes (listing needs no physics)."""
+    import tomllib
+
+    out = []
+    for name in builtin_names():
+        data = tomllib.loads((builtin_dir() / f"{name}.toml").read_text(encoding="utf-8"))
+        out.append((name, str(data.get("description", ""))))
+    return out
