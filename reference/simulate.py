@@ -32,8 +32,11 @@ from .scene import Scene
 from .stats import RunStats
 from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
 
-# initial rows of the output arrays (they grow by doubling when the loop asks)
-INITIAL_ROWS = {"samples": 4096, "impacts": 1024, "phases": 1024, "accumulations": 64}
+# Rows of the output arrays: enough for max_impacts impacts and the sample grid (two
+# samples and about two phases per impact), allocated uninitialised, so the memory
+# pages are touched only as rows are written; they double when the loop asks for more.
+ROWS_PER_IMPACT = {"samples": 2, "phases": 2}
+MIN_ROWS = 64
 
 
 @dataclass
@@ -78,7 +81,7 @@ class Problem:
 
 
 def _grown(arr: np.ndarray, rows: int) -> np.ndarray:
-    new = np.zeros((rows, *arr.shape[1:]), dtype=arr.dtype)
+    new = np.empty((rows, *arr.shape[1:]), dtype=arr.dtype)
     new[: len(arr)] = arr
     return new
 
@@ -124,20 +127,22 @@ def initial_record(y0: np.ndarray) -> np.ndarray:
 
 
 def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
-    rows = INITIAL_ROWS
-    n_s = min(rows["samples"], max(opts.max_samples, 1))
+    n_imp = min(scene.run.max_impacts, 10_000_000) + MIN_ROWS
+    grid = t_end / (opts.sample_dt or t_end / 2000.0)
+    n_s = int(min(max(opts.max_samples, 1), ROWS_PER_IMPACT["samples"] * n_imp + grid + MIN_ROWS))
+    n_ph = ROWS_PER_IMPACT["phases"] * n_imp
     return Problem(
         model=model_record(scene),
         points=np.array(contact_points(scene.body, scene.ground), dtype=float, order="C"),
         options=options_record(scene, t_end, opts),
         state=initial_record(initial_state(scene.initial)),
         counters=np.zeros(1, dtype=R.STATS),
-        sample_t=np.zeros((n_s, 2)),
-        sample_y=np.zeros((n_s, 13)),
-        sample_e=np.zeros((n_s, 2)),
-        impacts=np.zeros((rows["impacts"], 6)),
-        phases=np.zeros((rows["phases"], 6)),
-        accumulations=np.zeros(rows["accumulations"]),
+        sample_t=np.empty((n_s, 2)),
+        sample_y=np.empty((n_s, 13)),
+        sample_e=np.empty((n_s, 2)),
+        impacts=np.empty((n_imp, 6)),
+        phases=np.empty((n_ph, 6)),
+        accumulations=np.empty(MIN_ROWS),
         counts=np.zeros(5, dtype=np.int64),
     )
 

@@ -12,7 +12,7 @@ from scipy.integrate._ivp import dop853_coefficients as scipy_dop
 from reference import quaternion as qt
 from reference.core import dop853_tableau as tab
 from reference.core.contacts import vertex_lever
-from reference.core.dop853 import INT_DONE, integrate_held, new_stepper
+from reference.core.dop853 import INT_DONE, integrate_held
 from reference.core.held import held_rhs, new_work
 from reference.core.output import Output
 from tests.conftest import core_model, make_scene
@@ -55,11 +55,11 @@ def test_integration_is_scipys_dop853_step_for_step(two):
     y0 = _held_state(two)
     rtol = 1e-12
     atol = np.full(13, 1e-14)
-    work = new_work()
+    scratch = new_work()
 
     def rhs(_t, y):
         dy = np.empty(13)
-        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, work, dy)
+        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, scratch[0], dy)
         return dy
 
     ref = solve_ivp(rhs, (0.0, 0.3), y0, method="DOP853", rtol=rtol, atol=atol)
@@ -68,9 +68,10 @@ def test_integration_is_scipys_dop853_step_for_step(two):
         np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
         np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
     )  # fmt: skip
+    ours = new_work()
     r = integrate_held(
-        y, 0.3, model, pts, idx, m, rtol, atol, new_work(), new_stepper(), np.zeros(0), 0,
-        out, (0.0, 0.0), 0, False,
+        y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], np.zeros(0), 0, out,
+        (0.0, 0.0), 0, False,
     )  # fmt: skip
     assert r.status == INT_DONE
     assert r.nfev == ref.nfev

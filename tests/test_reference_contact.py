@@ -53,10 +53,10 @@ def rocking_state(wy=1.5, wz=0.0, tilt=0.3):
 
 def contact_force(scene, y, k):
     model, pts = core_model(scene)
-    work = new_work()
-    _, ok = held_forces(y, model, pts, np.array([k, 0, 0]), 1, work)
+    scratch = new_work()
+    _, ok = held_forces(y, model, pts, np.array([k, 0, 0]), 1, scratch[0])
     assert ok
-    return work.lam[0]
+    return scratch[0]["lam"][0]
 
 
 def test_single_contact_force_matches_independent_newton_euler_solve():

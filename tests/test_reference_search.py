@@ -70,7 +70,8 @@ def _product_event(scene, y, window):
     fc = flight_constants(y, scene.body.inertia_diag[0], scene.body.inertia_diag[2])
     bounds = flight_bounds(y, fc, model, pts, 10.0)
     out, together = np.empty(13), np.empty(len(pts), dtype=np.int64)
-    ev = find_flight_event(y, fc, bounds, model, pts, window, 10.0, 100_000, out, together)
+    res = np.empty(5)
+    ev = find_flight_event(y, fc, bounds, model, pts, window, 10.0, 100_000, out, together, res)
     return ev, sorted(together[: ev.n_together].tolist())
 
 

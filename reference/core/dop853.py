@@ -34,27 +34,10 @@ INT_DONE, INT_LIFT_OFF, INT_FAILED = 0, 1, 2
 # leaving: index (into the held list) of the contact whose force reached zero
 Integration = namedtuple("Integration", ["status", "s", "nfev", "leaving"])
 
-# Stages K (13 rows: 12 stages and f(y_new)) of the steps taken and of the one-step
-# evaluations (Ks), state and scale vectors, the held forces at the current state and at
-# the end of the step just accepted.
-Stepper = namedtuple(
-    "Stepper", ["K", "Ks", "f", "y_new", "ys", "scale", "tmp", "lam_cur", "lam_new"]
-)
-
-
-@njit(cache=True)
-def new_stepper():
-    return Stepper(
-        np.empty((N_STAGES + 1, 13)),
-        np.empty((N_STAGES + 1, 13)),
-        np.empty(13),
-        np.empty(13),
-        np.empty(13),
-        np.empty(13),
-        np.empty(13),
-        np.zeros(3),
-        np.zeros(3),
-    )
+# `st` in this module is a records.SCRATCH record: stages K (13 rows: 12 stages and
+# f(y_new)) of the steps taken and Ks of one-step evaluations, state and scale vectors,
+# the held forces at the current state (lam_cur) and at the end of the step just
+# accepted (lam_new).  The held functions use the same record as their `work`.
 
 
 @njit(cache=True)

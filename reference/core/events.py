@@ -3,7 +3,6 @@ contacts it leaves held), an activation (contacts landing at rest start to be he
 and the start of the run.  Each returns False when it ended the run (state.status
 set), True otherwise."""
 
-import numpy as np
 from numba import njit
 
 from .chatter import accumulation_time, completion_speed
@@ -43,10 +42,10 @@ def hold(state, model, pts, ws, cand, m):
         for i in range(3):
             state.active[i] = cand[i]
         return True
-    if not zero_normal_velocities(state.y, model, pts, cand, m, ws.work):
+    if not zero_normal_velocities(state.y, model, pts, cand, m, ws):
         end_run(state, STATUS_FAILED_LCP, cand, m)
         return False
-    n = solve_lcp(state.y, model, pts, cand, m, ws.work, ws.active)
+    n = solve_lcp(state.y, model, pts, cand, m, ws, ws.active)
     if n < 0:
         end_run(state, STATUS_FAILED_LCP, cand, m)
         return False
@@ -60,7 +59,7 @@ def hold(state, model, pts, ws, cand, m):
 def _completes(state, model, pts, ws, k, m, u, vnoise):
     """Whether contact k, separating at u ≤ the completion speed with cand[:m] held,
     falls back (a_n < 0) or is at rest: then its chatter is completed."""
-    acc = held_acceleration(state.y, model, pts, ws.cand, m, ws.work)
+    acc = held_acceleration(state.y, model, pts, ws.cand, m, ws)
     a_n = contact_jet(state.y, model.flat_ground, pts, k, acc).accel
     return a_n < 0 or u <= vnoise, a_n
 
@@ -81,11 +80,11 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
     vnoise = rate_noise(y, model.radius)
     ws.y_start[:] = y
     out_imp = impact(y, model, pts, k)
-    n_pushed = pushed_contacts(y, model, pts, resting, n_rest, vnoise, ws.together)
+    n_pushed = pushed_contacts(y, model, pts, resting, n_rest, vnoise, ws.before)
     if n_pushed > 0:
         y[:] = ws.y_start
         state.info_contact = k
-        end_run(state, STATUS_PUSHED, ws.together, n_pushed)
+        end_run(state, STATUS_PUSHED, ws.before, n_pushed)
         return False
     push_impact(out, state.t_hi, state.t_lo, k, out_imp.impulse, out_imp.u_pre, out_imp.u_post)
     small = completion_speed(y, model, pts, k, opts.chatter_tol, vnoise)
@@ -139,11 +138,12 @@ def activate(state, model, pts, ws, stats, landing, n_land):
             m += 1
     np_sort_prefix(ws.cand, m)
     n_held_before = state.n_active
-    before = state.active.copy()
+    for i in range(n_held_before):
+        ws.before[i] = state.active[i]
     stats.activations += 1
     if not hold(state, model, pts, ws, ws.cand, m):
         return False
-    if _same_set(state.active, state.n_active, before, n_held_before):
+    if _same_set(state.active, state.n_active, ws.before, n_held_before):
         state.n_active = m
         for i in range(m):
             state.active[i] = ws.cand[i]
@@ -175,7 +175,7 @@ def _same_set(a, na, b, nb):
 
 
 @njit(cache=True)
-def start(state, model, pts, opts, stats, out, ws):
+def start(state, model, pts, opts, stats, out, ws, cs):
     """The run's first step: sample the initial state, then resolve contacts touching at
     t = 0 (hitting: an impact with the resting ones held; resting only: hold them).
     A body with every contact resting is already at the end of its motion."""
@@ -186,8 +186,7 @@ def start(state, model, pts, opts, stats, out, ws):
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
     vnoise = rate_noise(y, model.radius)
     n_hit = n_rest = 0
-    hitting = np.empty(pts.shape[0], dtype=np.int64)
-    resting = np.empty(pts.shape[0], dtype=np.int64)
+    hitting, resting = cs.hitting, cs.together
     for k in range(pts.shape[0]):
         f = contact_frame(y, model.flat_ground, pts, k)
         if f.gap > f.noise:

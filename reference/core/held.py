@@ -11,28 +11,23 @@ velocities by normal impulses (`zero_normal_velocities`), so the constraints nev
 drift.  Impulses act along the normals: on flat ground horizontal momentum and the
 vertical angular momentum are untouched."""
 
-from collections import namedtuple
-
 import numpy as np
 from numba import njit
 
 from .contacts import contact_frame, normal_acceleration, normal_velocity
 from .inertia import apply_impulse, free_acceleration, impulse_response
 from .linalg import solve_small
-from .records import Response
+from .records import SCRATCH, Response
 from .rotation import quaternion_rate, rotate_attitude
 from .tolerances import PROJECTION_PASSES
 
-# Work arrays for up to three contacts: A (3 × 3), b, rhs and solution (3), impulse
-# responses M⁻¹J_iᵀ and w (3 × 7), normal/lever rows (3 × 6).
-Work = namedtuple("Work", ["A", "b", "r", "lam", "resp", "geo"])
+# `work` in this module is a records.SCRATCH record: A (3 × 3), b, r, lam (3),
+# resp (3 × 7: M⁻¹J_iᵀ and w_i), geo (3 × 6: normal and lever) of up to three contacts.
 
 
-@njit(cache=True)
 def new_work():
-    return Work(
-        np.zeros((3, 3)), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros((3, 7)), np.zeros((3, 6))
-    )
+    """A scratch record for calls from Python (tests): keep the array, pass its [0]."""
+    return np.zeros(1, dtype=SCRATCH)
 
 
 @njit(cache=True)

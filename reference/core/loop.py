@@ -33,6 +33,7 @@ from .records import (
     RETURN_DONE,
     RETURN_GROW,
     RETURN_YIELD,
+    SCRATCH,
     STATUS_ENERGY_EXHAUSTED,
     STATUS_FAILED_NONFINITE,
     STATUS_MAX_IMPACTS,
@@ -40,7 +41,7 @@ from .records import (
     STATUS_SINGULARITY,
     STATUS_T_END,
 )
-from .workspace import new_workspace
+from .workspace import new_contact_lists
 
 # rows every step may add at most to impacts, phases and accumulation times
 STEP_ROWS = 4
@@ -66,7 +67,7 @@ def extrapolate_singularity(out, t_hi):
 def _motion_ended(state, model, opts, out):
     """The end checks between phases (max_impacts, all contacts down, energy exhausted,
     t_end); sets the status and returns True when one applies."""
-    none = np.empty(0, dtype=np.int64)
+    none = state.info  # (no contacts to name)
     if out.counts[N_IMPACTS] >= opts.max_impacts:
         end_run(state, STATUS_MAX_IMPACTS, none, 0)
         return True
@@ -107,20 +108,20 @@ def _finite(y):
 
 
 @njit(cache=True)
-def loop_step(state, model, pts, opts, stats, out, ws):
+def loop_step(state, model, pts, opts, stats, out, ws, cs):
     """One step: the run's start, a contact chunk (or the event ending the phase), or a
     flight to its event, after the end checks between phases."""
     if not state.started:
-        start(state, model, pts, opts, stats, out, ws)
+        start(state, model, pts, opts, stats, out, ws, cs)
         return 0
     if state.in_contact:
-        return contact_step(state, model, pts, opts, stats, out, ws)
+        return contact_step(state, model, pts, opts, stats, out, ws, cs)
     if _motion_ended(state, model, opts, out):
         return 0
     if state.n_active > 0:
         begin_contact_phase(state, model, opts)
-        return contact_step(state, model, pts, opts, stats, out, ws)
-    return flight_step(state, model, pts, opts, stats, out, ws)
+        return contact_step(state, model, pts, opts, stats, out, ws, cs)
+    return flight_step(state, model, pts, opts, stats, out, ws, cs)
 
 
 @njit(cache=True)
@@ -134,15 +135,17 @@ def run_events(
     STATE, STATS); the output arrays and their row counts are those of output.Output."""
     model, opts, state, stats = model_rec[0], opts_rec[0], state_rec[0], stats_rec[0]
     out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, counts)
-    ws = new_workspace(pts.shape[0])
+    scratch = np.zeros(1, dtype=SCRATCH)  # owns the memory of the record ws
+    ws = scratch[0]
+    cs = new_contact_lists(pts.shape[0])
     for _ in range(opts.work_budget):
         if state.status != STATUS_RUNNING:
             return RETURN_DONE
         if _rows_short(out):
             return RETURN_GROW
-        if loop_step(state, model, pts, opts, stats, out, ws) == NEEDS_ROWS:
+        if loop_step(state, model, pts, opts, stats, out, ws, cs) == NEEDS_ROWS:
             return RETURN_GROW
         stats.loop_steps += 1
         if state.status == STATUS_RUNNING and not _finite(state.y):
-            end_run(state, STATUS_FAILED_NONFINITE, ws.together, 0)
+            end_run(state, STATUS_FAILED_NONFINITE, cs.together, 0)
     return RETURN_DONE if state.status != STATUS_RUNNING else RETURN_YIELD

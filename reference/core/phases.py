@@ -81,7 +81,7 @@ def _needed(n_grid, out, opts):
 
 
 @njit(cache=True)
-def flight_step(state, model, pts, opts, stats, out, ws):
+def flight_step(state, model, pts, opts, stats, out, ws, cs):
     """Free flight from the state to its first event (or to t_end), then the event."""
     y = state.y
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
@@ -89,10 +89,10 @@ def flight_step(state, model, pts, opts, stats, out, ws):
     bounds = flight_bounds(y, fc, model, pts, remaining)
     ev = find_flight_event(
         y, fc, bounds, model, pts, opts.window_search, remaining, MAX_SEARCH_ITERATIONS,
-        ws.y_event, ws.together,
+        ws.y_event, cs.together, ws.res,
     )  # fmt: skip
     if ev.kind == EVENT_STUCK:
-        end_run(state, STATUS_FAILED_STUCK, ws.together, 0)
+        end_run(state, STATUS_FAILED_STUCK, cs.together, 0)
         return DONE
     n_grid = grid_count(state.t_hi, state.t_lo, ev.s, opts.sample_dt)
     if _needed(n_grid, out, opts):
@@ -117,10 +117,11 @@ def flight_step(state, model, pts, opts, stats, out, ws):
     if ev.kind == EVENT_NONE:
         return DONE
     if ev.kind == EVENT_ACTIVATION:
-        activate(state, model, pts, ws, stats, ws.together, ev.n_together)
+        activate(state, model, pts, ws, stats, cs.together, ev.n_together)
         return DONE
-    hitting = ws.together[: ev.n_together].copy()
-    resolve_impact(state, model, pts, opts, stats, out, ws, hitting, ev.n_together, state.active, 0)
+    resolve_impact(
+        state, model, pts, opts, stats, out, ws, cs.together, ev.n_together, state.active, 0
+    )
     return DONE
 
 
@@ -156,44 +157,45 @@ def close_contact_phase(state, model, stats, out):
 
 
 @njit(cache=True)
-def _contact_jets(state, model, pts, ws):
-    """Jets of every contact with the held acceleration (forces into ws.work.lam)."""
-    acc = held_acceleration(state.y, model, pts, state.active, state.n_active, ws.work)
+def _contact_jets(state, model, pts, ws, cs):
+    """Jets of every contact with the held acceleration (forces into ws.lam)."""
+    acc = held_acceleration(state.y, model, pts, state.active, state.n_active, ws)
     for k in range(pts.shape[0]):
         j = contact_jet(state.y, model.flat_ground, pts, k, acc)
-        ws.gap[k], ws.rate[k], ws.accel[k], ws.noise[k] = j.gap, j.rate, j.accel, j.noise
-        ws.held[k] = False
+        cs.gap[k], cs.rate[k], cs.accel[k], cs.noise[k] = j.gap, j.rate, j.accel, j.noise
+        cs.held[k] = False
     for i in range(state.n_active):
-        ws.held[state.active[i]] = True
+        cs.held[state.active[i]] = True
 
 
 @njit(cache=True)
-def _touching_event(state, model, pts, opts, stats, out, ws, gap_res):
+def _touching_event(state, model, pts, opts, stats, out, ws, cs, gap_res):
     """A free contact touching (gap within max(noise, gap_res)) while approaching (an
     impact with the held ones) or at rest accelerating into the ground (activation)
     ends the phase.  Returns True if so."""
     vnoise = rate_noise(state.y, model.radius)
     n_hit = n_land = 0
-    hitting = np.empty(pts.shape[0], dtype=np.int64)
+    hitting = cs.hitting
     for k in range(pts.shape[0]):
-        if ws.held[k] or ws.gap[k] > max(ws.noise[k], gap_res):
+        if cs.held[k] or cs.gap[k] > max(cs.noise[k], gap_res):
             continue
-        if ws.rate[k] < -vnoise:
+        if cs.rate[k] < -vnoise:
             hitting[n_hit] = k
             n_hit += 1
-        elif ws.rate[k] <= vnoise and ws.accel[k] < 0:
-            ws.together[n_land] = k
+        elif cs.rate[k] <= vnoise and cs.accel[k] < 0:
+            cs.together[n_land] = k
             n_land += 1
     if n_hit:
         close_contact_phase(state, model, stats, out)
-        held = state.active[: state.n_active].copy()
+        for i in range(state.n_active):
+            ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, hitting, n_hit, held, state.n_active
+            state, model, pts, opts, stats, out, ws, hitting, n_hit, ws.held, state.n_active
         )
         return True
     if n_land:
         close_contact_phase(state, model, stats, out)
-        activate(state, model, pts, ws, stats, ws.together, n_land)
+        activate(state, model, pts, ws, stats, cs.together, n_land)
         return True
     return False
 
@@ -213,39 +215,39 @@ def _set_tolerances(y, model, rtol, atol):
 
 
 @njit(cache=True)
-def _crossed(y, model, pts, ws, gap_res):
+def _crossed(y, model, pts, cs, gap_res):
     """Free contacts below the ground beyond their resolution at y: how many (listed in
-    ws.together)."""
+    cs.together)."""
     n = 0
     for k in range(pts.shape[0]):
-        if ws.held[k]:
+        if cs.held[k]:
             continue
         f = contact_frame(y, model.flat_ground, pts, k)
         if f.gap < -max(f.noise, gap_res):
-            ws.together[n] = k
+            cs.together[n] = k
             n += 1
     return n
 
 
 @njit(cache=True)
-def _min_gap_after(state, model, pts, opts, ws, s, n_crossed, out):
+def _min_gap_after(state, model, pts, opts, ws, cs, s, n_crossed, out):
     """Lowest gap of the crossed contacts after integrating (and projecting) the held
     motion for s from the chunk's start (ws.y_start); the state into ws.y_chunk."""
     ws.y_chunk[:] = ws.y_start
     grid = np.empty(0)
     r = integrate_held(
         ws.y_chunk, s, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
-        ws.work, ws.stepper, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False,
+        ws, ws, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False,
     )  # fmt: skip
-    project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws.work)
+    project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
     g = math.inf
     for i in range(n_crossed):
-        g = min(g, contact_frame(ws.y_chunk, model.flat_ground, pts, ws.together[i]).gap)
+        g = min(g, contact_frame(ws.y_chunk, model.flat_ground, pts, cs.together[i]).gap)
     return g, r.nfev
 
 
 @njit(cache=True)
-def _locate_crossing(state, model, pts, opts, stats, out, ws, h, n_crossed):
+def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
     """The first time in (0, h] the crossed contacts reach the ground (bisection on
     re-integrations from the chunk's start): the horizon's backstop (it should be rare:
     the bound makes crossings impossible up to roundoff)."""
@@ -254,29 +256,29 @@ def _locate_crossing(state, model, pts, opts, stats, out, ws, h, n_crossed):
         if hi - lo <= LOCATE_XTOL * h + 4.0 * 2.220446049250313e-16 * hi:
             break
         mid = 0.5 * (lo + hi)
-        g, nfev = _min_gap_after(state, model, pts, opts, ws, mid, n_crossed, out)
+        g, nfev = _min_gap_after(state, model, pts, opts, ws, cs, mid, n_crossed, out)
         stats.contact_rhs_evals += nfev
         if g > 0.0:
             lo = mid
         else:
             hi = mid
-    g, nfev = _min_gap_after(state, model, pts, opts, ws, hi, n_crossed, out)
+    g, nfev = _min_gap_after(state, model, pts, opts, ws, cs, hi, n_crossed, out)
     stats.contact_rhs_evals += nfev
     return hi
 
 
 @njit(cache=True)
-def contact_step(state, model, pts, opts, stats, out, ws):
+def contact_step(state, model, pts, opts, stats, out, ws, cs):
     """One step of a contact phase: the event that ends it, or one integrated chunk."""
     y = state.y
     gap_res = state.gap_res
-    _contact_jets(state, model, pts, ws)
-    if _touching_event(state, model, pts, opts, stats, out, ws, gap_res):
+    _contact_jets(state, model, pts, ws, cs)
+    if _touching_event(state, model, pts, opts, stats, out, ws, cs, gap_res):
         return DONE
     m = state.n_active
-    lam = ws.work.lam[:m].copy()
+    lam = ws.lam[:m].copy()
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
-    h = chunk_horizon(y, model, ws.gap, ws.rate, ws.accel, ws.noise, ws.held)
+    h = chunk_horizon(y, model, cs.gap, cs.rate, cs.accel, cs.noise, cs.held)
     if state.has_trend:
         h = force_trend_limit(h, lam, state.lam_prev, state.h_prev, m)
     h = min(h, remaining)
@@ -295,20 +297,20 @@ def contact_step(state, model, pts, opts, stats, out, ws):
     ws.y_chunk[:] = y
     ns0 = out.counts[N_SAMPLES]
     r = integrate_held(
-        ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws.work,
-        ws.stepper, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True,
+        ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
+        ws, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     if r.status == INT_FAILED:
         end_run(state, STATUS_FAILED_INTEGRATION, state.active, m)
         return DONE
-    project_held(ws.y_chunk, model, pts, state.active, m, ws.work)
+    project_held(ws.y_chunk, model, pts, state.active, m, ws)
     if r.status == INT_LIFT_OFF:
         return _lift_off(state, model, pts, opts, stats, out, ws, r)
-    n_crossed = _crossed(ws.y_chunk, model, pts, ws, gap_res)
+    n_crossed = _crossed(ws.y_chunk, model, pts, cs, gap_res)
     if n_crossed:
         stats.horizon_backstops += 1
-        s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, h, n_crossed)
+        s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed)
         _drop_samples_after(out, ns0, state, s_star)
         state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_star)
         y[:] = ws.y_chunk
@@ -317,9 +319,9 @@ def contact_step(state, model, pts, opts, stats, out, ws):
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
     y[:] = ws.y_chunk
-    _, ok = held_forces(y, model, pts, state.active, m, ws.work)
+    _, ok = held_forces(y, model, pts, state.active, m, ws)
     for i in range(m):
-        state.lam_prev[i] = ws.work.lam[i]
+        state.lam_prev[i] = ws.lam[i]
     state.h_prev = h
     state.has_trend = True
     if remaining - h <= 0:

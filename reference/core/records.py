@@ -123,6 +123,38 @@ STATS = np.dtype(
     ]
 )
 
+# Scratch space of one run (reference.core.workspace): contact systems of up to three
+# contacts, the DOP853 stages, and states and lists of one event.  A record, so that the
+# many small functions it is passed to need no reference counting.
+SCRATCH = np.dtype(
+    [
+        ("A", np.float64, (3, 3)),  # J M⁻¹ Jᵀ of up to three contacts
+        ("b", np.float64, (3,)),  # their normal accelerations without contact forces
+        ("r", np.float64, (3,)),  # a right-hand side
+        ("lam", np.float64, (3,)),  # forces or impulses
+        ("resp", np.float64, (3, 7)),  # M⁻¹J_iᵀ and w_i per contact
+        ("geo", np.float64, (3, 6)),  # normal and lever per contact
+        ("K", np.float64, (13, 13)),  # DOP853 stages and f(y_new)
+        ("Ks", np.float64, (13, 13)),  # stages of one-step evaluations
+        ("f", np.float64, (13,)),
+        ("y_new", np.float64, (13,)),
+        ("ys", np.float64, (13,)),
+        ("scale", np.float64, (13,)),
+        ("tmp", np.float64, (13,)),
+        ("lam_cur", np.float64, (3,)),  # held forces at the current state
+        ("lam_new", np.float64, (3,)),  # held forces at the end of the step accepted
+        ("y_event", np.float64, (13,)),
+        ("y_chunk", np.float64, (13,)),
+        ("y_start", np.float64, (13,)),
+        ("atol", np.float64, (13,)),
+        ("res", np.float64, (5,)),  # the search's step / hit / landing bookkeeping
+        ("cand", np.int64, (4,)),  # candidates of an impact or activation
+        ("active", np.int64, (4,)),  # the LCP's answer
+        ("before", np.int64, (4,)),  # held contacts before an activation; pushed contacts
+        ("held", np.int64, (4,)),  # the held contacts when a contact phase ends
+    ]
+)
+
 # Columns of the impact rows the loop writes.
 IMPACT_COLUMNS = ("t", "t_lo", "contact", "impulse", "v_normal_pre", "v_normal_post")
 # Columns of the phase rows: kind 0 = flight, 1 = contact (held contacts, −1 padded).

@@ -44,9 +44,10 @@ def _critical_points(c1, c2, c3):
 @njit(cache=True)
 def _monotone_root(c0, c1, c2, c3, lo, hi):
     """A point below the root of the cubic on [lo, hi] (monotone there, positive at lo,
-    ≤ 0 at hi), within ROOT_REL_TOL of it: safeguarded Newton, pushed a little past
-    the root once its step is below the tolerance so that the bracket closes."""
-    x = 0.5 * (lo + hi)
+    ≤ 0 at hi), within ROOT_REL_TOL of it: safeguarded Newton from lo (from the middle
+    when lo = 0), pushed a little past the root once its step is below the tolerance so
+    that the bracket closes."""
+    x = lo if lo > 0.0 else 0.5 * (lo + hi)
     for _ in range(200):
         f = _cubic_value(c0, c1, c2, c3, x)
         if f > 0.0:
@@ -67,12 +68,13 @@ def _monotone_root(c0, c1, c2, c3, lo, hi):
 
 
 @njit(cache=True)
-def cubic_first_root(c0, c1, c2, c3):
+def cubic_first_root(c0, c1, c2, c3, start=0.0):
     """First positive root of c0 + c1 x + c2 x² + c3 x³ (c0 > 0, c3 ≤ 0), from below
-    within ROOT_REL_TOL; inf if there is none.  The critical points split (0, ∞) into
-    monotone pieces; the first whose end value is ≤ 0 holds the root."""
+    within ROOT_REL_TOL; inf if there is none.  `start`: a point up to which the cubic is
+    known to stay positive.  The critical points split (start, ∞) into monotone pieces;
+    the first whose end value is ≤ 0 holds the root."""
     m, cr0, cr1 = _critical_points(c1, c2, c3)
-    lo = 0.0
+    lo = start
     for i in range(m + 1):
         if i < m:
             hi = cr0 if i == 0 else cr1
@@ -139,6 +141,69 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
     d2 = quadratic_first_root(g, g1, K)
     if d2 >= cap:
         return d2
-    if cap < math.inf and cubic_positive_on(g, g1, 0.5 * g2, -B / 6.0, cap):
+    c2, c3 = 0.5 * g2, -B / 6.0
+    if not cubic_positive_on(g, g1, c2, c3, d2):
+        return d2  # P3's first root comes before P2's: P2 binds
+    if cap < math.inf and cubic_positive_on(g, g1, c2, c3, cap):
         return cap
-    return max(d2, cubic_first_root(g, g1, 0.5 * g2, -B / 6.0))
+    return cubic_first_root(g, g1, c2, c3, d2)
+
+
+@njit(cache=True)
+def _rising_cubic_root(c0, c1, c2, c3):
+    """First positive root of c0 + c1 x + c2 x² + c3 x³ with c0 > 0, c1 < 0, c3 ≥ 0, as a
+    point at or just past it (where the cubic is ≤ 0), within ROOT_REL_TOL; inf if the
+    cubic stays positive (its one local minimum on x > 0 is above zero)."""
+    if c3 == 0.0:
+        if c2 <= 0.0:
+            return -c0 / c1 if c2 == 0.0 else quadratic_first_root(c0, c1, -2.0 * c2)
+        xm = -c1 / (2.0 * c2)
+    else:
+        xm = (-c2 + math.sqrt(c2 * c2 - 3.0 * c3 * c1)) / (3.0 * c3)
+    if _cubic_value(c0, c1, c2, c3, xm) > 0.0:
+        return math.inf
+    lo, hi = 0.0, xm  # decreasing on [0, xm]: bisection with Newton steps
+    for _ in range(200):
+        if hi - lo <= ROOT_REL_TOL * hi:
+            break
+        x = 0.5 * (lo + hi)
+        f = _cubic_value(c0, c1, c2, c3, x)
+        d = c1 + x * (2.0 * c2 + 3.0 * x * c3)
+        nxt = x - f / d if d < 0.0 else x
+        if f > 0.0:
+            lo = x
+        else:
+            hi = x
+        if lo < nxt < hi:
+            if _cubic_value(c0, c1, c2, c3, nxt) > 0.0:
+                lo = nxt
+            else:
+                hi = nxt
+    return hi
+
+
+@njit(cache=True)
+def zero_bracket_end(g, g1, g2, K, B):
+    """An end of a bracket [safe step, end] that holds the gap's first zero and no other,
+    for a gap g > 0 approaching (g1 < 0): the first zero of an upper bound of the gap
+    (U2 = g + g1 δ + K δ²/2, else U3 = g + g1 δ + g2 δ²/2 + B δ³/6), provided the gap is
+    still decreasing there (`_decreasing_until`).  inf when there is no such end."""
+    if g1 >= 0.0 or g <= 0.0:
+        return math.inf
+    disc = g1 * g1 - 2.0 * K * g
+    if disc >= 0.0:  # U2's zero, in closed form, is enough when the rate stays negative
+        end = 2.0 * g / (-g1 + math.sqrt(disc))
+        if _decreasing_until(g1, g2, K, B, end):
+            return end
+    end = _rising_cubic_root(g, g1, 0.5 * g2, B / 6.0)
+    if end < math.inf and _decreasing_until(g1, g2, K, B, end):
+        return end
+    return math.inf
+
+
+@njit(cache=True)
+def _decreasing_until(g1, g2, K, B, end):
+    """Whether a gap with rate g1 < 0, acceleration g2 and |g″| ≤ K, |g‴| ≤ B now is
+    still decreasing at every time up to `end`: its rate is at most g1 + Kδ and
+    g1 + g2 δ + B δ²/2 (convex in δ), so it suffices that either is negative at end."""
+    return g1 + K * end < 0.0 or g1 + end * (g2 + 0.5 * B * end) < 0.0

@@ -17,15 +17,15 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 
 import math
 
-import numpy as np
 from numba import njit
 
 from .contacts import contact_jet, point_jet
 from .flight import flight_acceleration, free_flight
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
-from .roots import safe_step
+from .roots import safe_step, zero_bracket_end
 from .rotation import rotation_columns_xy
 from .tolerances import (
+    BRACKET_ITERATIONS,
     EPS,
     GRAZE_FACTOR,
     MIN_STEP_REL,
@@ -38,9 +38,9 @@ from .tolerances import (
     WINDOW_MAX,
 )
 
-# res[...] of `examine`: the smallest safe step, the earliest hit's time and contact, a
-# contact landing at rest
-STEP, HIT_DS, HIT_K, LAND_K = range(4)
+# res[...] of `examine`: the smallest safe step and the contact that sets it, the
+# earliest hit's time and contact, a contact landing at rest
+STEP, STEP_K, HIT_DS, HIT_K, LAND_K = range(5)
 
 
 @njit(cache=True)
@@ -64,6 +64,7 @@ def examine(y, acc, flat, pts, k, K, B, vnoise, res):
     d = safe_step(g, j.rate, j.accel, K, B, res[STEP])
     if d < res[STEP]:
         res[STEP] = d
+        res[STEP_K] = k
 
 
 @njit(cache=True)
@@ -198,7 +199,13 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
     lowest direction.  Returns (step, last certified window step)."""
     n = pts.shape[0]
     K, B = bounds.K, bounds.B
-    res[STEP], res[HIT_DS], res[HIT_K], res[LAND_K] = math.inf, math.inf, -1.0, -1.0
+    res[STEP], res[STEP_K], res[HIT_DS], res[HIT_K], res[LAND_K] = (
+        math.inf,
+        -1.0,
+        math.inf,
+        -1.0,
+        -1.0,
+    )
     if not windowed:
         if model.flat_ground:
             k0, _ = vertex_window(y, model.radius, n, K, 0.0, 0)
@@ -218,6 +225,74 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
     if cap < math.inf:
         last_dlt = cap
     return max(min(res[STEP], cap), d_c), last_dlt
+
+
+@njit(cache=True)
+def _others_safe_until(y, acc, model, pts, k, end, K, B, windowed):
+    """Whether every contact but k stays above the ground over [0, end] (its lower bound
+    max(P2, P3) has no root before end; a touching contact is not certified).  With the
+    window search only the vertices of window(end) are examined: the others are safe
+    over [0, end] by P2 (`vertex_window`)."""
+    n = pts.shape[0]
+    first, half = 0, n // 2
+    if windowed:
+        first, half = vertex_window(y, model.radius, n, K, end, 3)
+    for i in range(min(2 * half + 1, n)):
+        j = (first - half + i) % n
+        if j == k:
+            continue
+        jt = contact_jet(y, model.flat_ground, pts, j, acc)
+        if jt.gap <= jt.noise or safe_step(jt.gap, jt.rate, jt.accel, K, B, end) < end:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
+    """Contact k's single zero in [lo, hi] (gap > 0 at lo, ≤ 0 at hi, decreasing):
+    Newton steps kept inside the shrinking bracket (bisection otherwise), until a step
+    or the bracket is within two ulps; y ends at the zero, which is returned."""
+    x = lo
+    for _ in range(BRACKET_ITERATIONS):
+        free_flight(y0, fc, gravity, x, y)
+        j = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, gravity))
+        if j.gap > 0.0:
+            lo = x
+        else:
+            hi = x
+        nxt = x - j.gap / j.rate if j.rate < 0.0 else 0.5 * (lo + hi)
+        if not lo <= nxt <= hi:
+            nxt = 0.5 * (lo + hi)
+        if abs(nxt - x) <= 2.0 * EPS * abs(x) or hi - lo <= 2.0 * EPS * hi:
+            return x  # converged to the last bits: y is the state at x
+        x = nxt
+    free_flight(y0, fc, gravity, x, y)
+    return x
+
+
+@njit(cache=True)
+def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, windowed, res, y):
+    """The shortcut of a transversal approach: when the contact that sets the step
+    (res[STEP_K]) is approaching with its first zero bracketed in [step, end]
+    (roots.zero_bracket_end) and every other contact is safe until end, that zero is the
+    flight's next event: returns its time with y there (the impact test of `examine`
+    holds there), or −1 when the shortcut does not apply (y then undefined)."""
+    k = int(res[STEP_K])
+    flat = model.flat_ground
+    j = contact_jet(y, flat, pts, k, acc)
+    if j.gap <= j.noise:
+        return -1.0
+    end = zero_bracket_end(j.gap, j.rate, j.accel, bounds.K, bounds.B)
+    if not s + end < horizon:
+        return -1.0
+    if not _others_safe_until(y, acc, model, pts, k, end, bounds.K, bounds.B, windowed):
+        return -1.0
+    x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, y)
+    jr = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, model.gravity))
+    graze = GRAZE_FACTOR * math.sqrt(2.0 * max(jr.accel, 0.0) * jr.noise)
+    if jr.gap <= jr.noise and jr.rate < -max(vnoise, graze):
+        return x
+    return -1.0
 
 
 @njit(cache=True)
@@ -286,10 +361,12 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
 
 
 @njit(cache=True)
-def find_flight_event(y0, fc, bounds, model, pts, window_search, horizon, max_iter, y, together):
+def find_flight_event(
+    y0, fc, bounds, model, pts, window_search, horizon, max_iter, y, together, res
+):
     """The first event of the free flight from y0 within `horizon`: FlightEvent with y at
     its time (at the horizon when there is none) and the contacts reached in
-    together[:n_together]."""
+    together[:n_together] (res: 5 floats of scratch)."""
     n = pts.shape[0]
     g = model.gravity
     windowed = model.flat_ground and window_search and n > SMALL_N
@@ -300,7 +377,6 @@ def find_flight_event(y0, fc, bounds, model, pts, window_search, horizon, max_it
         * EPS
         * (math.sqrt(y0[7] ** 2 + y0[8] ** 2 + y0[9] ** 2) + model.radius * fc.wabs)
     )
-    res = np.empty(4)
     last_dlt = math.inf
     for it in range(max_iter):
         acc = flight_acceleration(fc, y, g)
@@ -316,6 +392,16 @@ def find_flight_event(y0, fc, bounds, model, pts, window_search, horizon, max_it
         if res[LAND_K] >= 0:
             m = collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together)
             return FlightEvent(EVENT_ACTIVATION, s, together[0], m, it)
+        if res[STEP_K] >= 0 and res[STEP] == step:
+            s_root = bracketed_zero(
+                y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, windowed, res, y
+            )
+            if s_root >= 0.0:
+                k = int(res[STEP_K])
+                acc = flight_acceleration(fc, y, g)
+                m = collect_together(y, acc, model, pts, bounds, windowed, k, vnoise, together)
+                return FlightEvent(EVENT_IMPACT, s_root, k, m, it)
+            free_flight(y0, fc, g, s, y)
         step = max(step, MIN_STEP_REL * max(s, TINY))
         if s + step >= horizon:
             free_flight(y0, fc, g, horizon, y)

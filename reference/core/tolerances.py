@@ -36,6 +36,9 @@ MIN_STEP_REL = 1e-15
 # correction is below POLISH_REL_TOL of the time.
 POLISH_ITERATIONS = 3
 POLISH_REL_TOL = 1e-16
+# Newton steps (bisection when they leave the bracket) for a bracketed zero: Newton
+# converges in a handful from the bracket's safe end; the cap only guards the loop.
+BRACKET_ITERATIONS = 60
 # Free-flight search iterations before the run is declared stuck.
 MAX_SEARCH_ITERATIONS = 100_000
 

@@ -1,49 +1,34 @@
-"""Scratch arrays of one run of the event loop, allocated once."""
+"""Scratch space of one run of the event loop, allocated once: a records.SCRATCH record
+(fixed-size arrays: contact systems, DOP853 stages, event states and lists) and the
+per-contact lists below (their size is the number of contacts)."""
 
 from collections import namedtuple
 
 import numpy as np
 from numba import njit
 
-from .dop853 import new_stepper
-from .held import new_work
-
-Workspace = namedtuple(
-    "Workspace",
+ContactLists = namedtuple(
+    "ContactLists",
     [
-        "work",  # held.Work: contact systems of up to three contacts
-        "stepper",  # dop853.Stepper
         "gap",  # (n,) jets of every contact
         "rate",
         "accel",
         "noise",
         "held",  # (n,) bool: held contacts
-        "together",  # (n,) contacts reached together / landing
-        "cand",  # (4,) candidate contacts of an impact or activation
-        "active",  # (4,) the LCP's answer
-        "y_event",  # (13,) scratch states
-        "y_chunk",
-        "y_start",
-        "atol",  # (13,) absolute tolerances of a chunk
+        "together",  # (n,) contacts reached together, landing, pushed, crossed
+        "hitting",  # (n,) contacts hitting
     ],
 )
 
 
 @njit(cache=True)
-def new_workspace(n):
-    return Workspace(
-        new_work(),
-        new_stepper(),
+def new_contact_lists(n):
+    return ContactLists(
         np.empty(n),
         np.empty(n),
         np.empty(n),
         np.empty(n),
         np.zeros(n, dtype=np.bool_),
         np.empty(n, dtype=np.int64),
-        np.empty(4, dtype=np.int64),
-        np.empty(4, dtype=np.int64),
-        np.empty(13),
-        np.empty(13),
-        np.empty(13),
-        np.empty(13),
+        np.empty(n, dtype=np.int64),
     )
