@@ -48,6 +48,7 @@ class Problem:
     options: np.ndarray  # records.OPTIONS
     state: np.ndarray  # records.STATE
     counters: np.ndarray  # records.STATS
+    scratch: np.ndarray  # records.SCRATCH: the loop's scratch space
     sample_t: np.ndarray
     sample_y: np.ndarray
     sample_e: np.ndarray
@@ -58,7 +59,7 @@ class Problem:
 
     def arguments(self) -> tuple:
         return (
-            self.model, self.points, self.options, self.state, self.counters,
+            self.model, self.points, self.options, self.state, self.counters, self.scratch,
             self.sample_t, self.sample_y, self.sample_e, self.impacts, self.phases,
             self.accumulations, self.counts,
         )  # fmt: skip
@@ -137,6 +138,7 @@ def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
         options=options_record(scene, t_end, opts),
         state=initial_record(initial_state(scene.initial)),
         counters=np.zeros(1, dtype=R.STATS),
+        scratch=np.zeros(1, dtype=R.SCRATCH),
         sample_t=np.empty((n_s, 2)),
         sample_y=np.empty((n_s, 13)),
         sample_e=np.empty((n_s, 2)),

@@ -61,7 +61,7 @@ def generated_scenes():
     yield (
         "n25-g0.5-three-point",
         make_scene(n=25, gamma=0.5, rho=0.7, q=(-0.01, 0.02, 0.05), p=(0.2, 0.1, -0.5), **three),
-        None,
+        80,  # its last few impacts are a chatter whose completion point is decided at roundoff
     )
     y = np.zeros(13)
     y[3:7] = [np.cos(0.01), np.sin(0.01), 0.0, 0.0]

@@ -35,6 +35,7 @@ def signatures() -> dict:
             rec(R.OPTIONS),
             rec(R.STATE),
             rec(R.STATS),
+            rec(R.SCRATCH),
             f2,
             f2,
             f2,

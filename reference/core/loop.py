@@ -18,7 +18,6 @@ arrays are full; the state record holds everything needed to resume."""
 
 import math
 
-import numpy as np
 from numba import njit
 
 from .clock import time_until
@@ -33,7 +32,6 @@ from .records import (
     RETURN_DONE,
     RETURN_GROW,
     RETURN_YIELD,
-    SCRATCH,
     STATUS_ENERGY_EXHAUSTED,
     STATUS_FAILED_NONFINITE,
     STATUS_MAX_IMPACTS,
@@ -126,17 +124,18 @@ def loop_step(state, model, pts, opts, stats, out, ws, cs):
 
 @njit(cache=True)
 def run_events(
-    model_rec, pts, opts_rec, state_rec, stats_rec, sample_t, sample_y, sample_e, impacts,
-    phases, accumulations, counts,
+    model_rec, pts, opts_rec, state_rec, stats_rec, scratch_rec, sample_t, sample_y, sample_e,
+    impacts, phases, accumulations, counts,
 ):  # fmt: skip
     """Run the loop from the state in state_rec until the run ends (RETURN_DONE), an
     output array needs rows (RETURN_GROW) or work_budget steps are done
     (RETURN_YIELD).  Records are 1-element structured arrays (records.MODEL, OPTIONS,
-    STATE, STATS); the output arrays and their row counts are those of output.Output."""
+    STATE, STATS, SCRATCH) that the caller owns, so that they outlive the call (a record
+    does not keep its array alive); the output arrays and their row counts are those of
+    output.Output."""
     model, opts, state, stats = model_rec[0], opts_rec[0], state_rec[0], stats_rec[0]
     out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, counts)
-    scratch = np.zeros(1, dtype=SCRATCH)  # owns the memory of the record ws
-    ws = scratch[0]
+    ws = scratch_rec[0]
     cs = new_contact_lists(pts.shape[0])
     for _ in range(opts.work_budget):
         if state.status != STATUS_RUNNING:

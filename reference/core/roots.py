@@ -130,6 +130,21 @@ def quadratic_first_root(g, g1, K):
 
 
 @njit(cache=True)
+def quadratic_taylor_root(g, g1, g2):
+    """First positive root of g + g1 δ + g2 δ²/2 (g > 0), cancellation-free; inf if
+    none (B = 0 makes P3 this Taylor quadratic, in closed form)."""
+    if g2 == 0.0:
+        return g / -g1 if g1 < 0.0 else math.inf
+    disc = g1 * g1 - 2.0 * g2 * g
+    if disc < 0.0:
+        return math.inf
+    sq = math.sqrt(disc)
+    if g2 < 0.0:  # concave: one positive root
+        return (g1 + sq) / -g2 if g1 >= 0.0 else 2.0 * g / (sq - g1)
+    return 2.0 * g / (sq - g1) if g1 < 0.0 else math.inf  # convex: the smaller root
+
+
+@njit(cache=True)
 def safe_step(g, g1, g2, K, B, cap=math.inf):
     """First positive root of max(P2, P3): no contact before it; 0 if g ≤ 0.
 
@@ -141,6 +156,8 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
     d2 = quadratic_first_root(g, g1, K)
     if d2 >= cap:
         return d2
+    if B == 0.0:
+        return max(d2, quadratic_taylor_root(g, g1, g2))
     c2, c3 = 0.5 * g2, -B / 6.0
     if not cubic_positive_on(g, g1, c2, c3, d2):
         return d2  # P3's first root comes before P2's: P2 binds
