@@ -159,9 +159,7 @@ def exponent_of_run(
     if fit["c"] is None:
         return out
     sel = imp[fit["selected"]]
-    out.update(
-        c=fit["c"], c_stderr=fit["c_stderr"], log_a=fit["log_a"], c_spread=fit["c_spread"]
-    )
+    out.update(c=fit["c"], c_stderr=fit["c_stderr"], log_a=fit["log_a"], c_spread=fit["c_spread"])
     bottom, top = fit["window"]
     dec = exponent_from_decades(run.log2_dt, lE, bottom, top)
     out["c_decades"], out["c_decades_spread"] = dec["c"], dec["c_spread"]
