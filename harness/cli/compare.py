@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import emit, load_scene_arg, log, positive_float
+from .common import emit, load_scene_arg, log, note, positive_float
 
 
 def register(sub) -> None:
@@ -31,8 +31,8 @@ def run(args) -> int:
         runs = [r.trajectory for r in result.runs if r.trajectory.n_samples > 0]
         skipped = len(result.runs) - len(runs)
         if skipped:
-            log(f"recording leaves out {skipped} run(s) that produced no samples")
+            note(f"recording leaves out {skipped} run(s) that produced no samples")
         path = record_trajectories([result.reference, *runs], args.record, scene=scene)
-        log(f"wrote {path}")
+        note(f"wrote {path}")
     emit(result.to_dict(), args.json, format_compare(result))
     return 0
