@@ -27,7 +27,7 @@ def followed_to_singularity(run: Trajectory, reference: Trajectory, match: Impac
         reference.status is Status.SINGULARITY
         and reference.t_singularity is not None
         and match.mismatch is None
-        and match.n_matched + match.skipped_reference == len(reference.impacts) > 0
+        and match.n_matched + match.skipped_reference == match.n_reference > 0
         and run.n_samples > 0
         and float(run.t[-1]) >= float(reference.t[-1])
     )
