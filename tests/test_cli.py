@@ -156,3 +156,22 @@ def test_pybullet_banner_does_not_reach_the_terminal():
         timeout=60,
     )
     assert (quiet.stdout, quiet.stderr) == ("ok\n", "")
+
+
+def test_figures_summary_says_for_each_claim_whether_it_was_reproduced():
+    from harness.figures import format_figures
+
+    doc = {
+        "a": {"agree": True, "headline": "c = 2.01 (paper: 2)", "ours": "x"},
+        "b": {"agree": False, "note": "only in part", "headline": "1 of 3", "ours": "x"},
+        "c": {"agree": False, "ours": "c = 3.5 (paper: 2) " * 10},
+    }
+    text = format_figures(doc, Path("out"))
+    lines = text.splitlines()
+    assert max(map(len, lines)) <= 100
+    assert any(
+        line.split() == ["reproduced", "a:", "c", "=", "2.01", "(paper:", "2)"] for line in lines
+    )
+    assert any(line.strip().startswith("partly  b: 1 of 3") for line in lines)
+    assert any(line.strip().startswith("NOT reproduced  c: c = 3.5") for line in lines)
+    assert "{" not in text
