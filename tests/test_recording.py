@@ -243,7 +243,7 @@ def test_only_the_run_that_reached_the_singularity_has_an_exponent(recorded):
     path, _ = recorded
     lines = [
         static_value(path, f"/singularity/energy/legend/{k}", "Points2D:labels")[0]
-        for k in range(5)
+        for k in range(1 + len(NAMES))  # what t_f is, then one line per run
     ]
     ref_line = next(x for x in lines if x.startswith("reference: "))
     c, se = map(float, re.search(r"c = ([\d.]+) ± ([\d.e-]+)", ref_line).groups())

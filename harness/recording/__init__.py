@@ -41,6 +41,9 @@ if TYPE_CHECKING:
     from ..compare import CompareResult
 
 APPLICATION_ID = "euler_disk_harness"
+# The log rows open on their top 6 decades (a plot ~120 pixels high labels every
+# decade of 6, only every tenth of 9); the log-log plots on the right show all decades.
+ROW_DECADES = 6.0
 DEFAULT_FOLDER = Path("recordings")
 __all__ = [
     "APPLICATION_ID",
@@ -98,9 +101,9 @@ def record_comparison(
 
 def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
     return RowRanges(
-        log_alpha=value_range([log10_positive(r.alpha) for r in runs], max_span=12.0),
+        log_alpha=value_range([log10_positive(r.alpha) for r in runs], max_span=ROW_DECADES),
         heading=value_range([r.psi for r in runs]),
-        log_excess=value_range([log10_positive(r.excess) for r in runs], max_span=16.0),
+        log_excess=value_range([log10_positive(r.excess) for r in runs], max_span=ROW_DECADES),
         raster=raster_range(len(runs), n_contacts),
     )
 

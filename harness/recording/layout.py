@@ -18,7 +18,6 @@ The time panel opens collapsed and paused at t = 0; the side panels collapsed.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,9 +54,8 @@ def value_range(
     if len(v) == 0:
         return None
     lo, hi = float(v.min()), float(v.max())
-    if max_span is not None:  # a log row: whole decades
-        lo = max(math.floor(lo), math.ceil(hi) - max_span)
-        return float(lo), float(math.ceil(hi + 0.05))
+    if max_span is not None:  # a log row: the top `max_span` decades
+        lo = max(lo, hi - max_span)
     span = max(hi - lo, 1e-9)
     return lo - pad * span, hi + pad * span
 
@@ -171,7 +169,7 @@ def build_blueprint(
             ),
             name="summary",
         ),
-        row_shares=[1.2, 1.0, 1.2],
+        row_shares=[1.35, 1.0, 1.1],
         name="near the singularity",
     )
     return rrb.Blueprint(

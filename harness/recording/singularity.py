@@ -172,8 +172,6 @@ def log_energy_plot(rec: rr.RecordingStream, runs: list[RunView], plot: Plot | N
 def energy_legend(runs: list[RunView], plot: Plot) -> list[tuple[str, tuple[int, int, int]]]:
     """The lines under the energy plot: what t_f is, then each run's exponent."""
     lines = [(plot.end.what, (190, 190, 190))]
-    if any(run.fit.c is not None for run in runs):
-        lines.append(("light lines: fit window · light dots: impacts fitted", (190, 190, 190)))
     for run in runs:
         fit = run.fit
         if fit.c is not None:
