@@ -25,7 +25,7 @@ import numpy as np
 import rerun as rr
 
 from reference.exponent import pre_impact_samples
-from reference.trajectory import Trajectory
+from reference.trajectory import Status, Trajectory
 
 from .plot2d import Axes, decade_bounds, draw_axes, legend
 from .rows import shade, time_column
@@ -178,6 +178,8 @@ def energy_legend(runs: list[RunView], plot: Plot) -> list[tuple[str, tuple[int,
             text = (
                 f"{run.label}: c = {fit.c:.3f} ± {fit.c_stderr:.2g} ({fit.fit_decades:.0f} decades)"
             )
+        elif run.trajectory.status is Status.SINGULARITY:
+            text = f"{run.label}: no c ({fit.reason})"
         else:
             text = f"{run.label}: no c ({run.trajectory.status.value})"
         lines.append((text, run.color))

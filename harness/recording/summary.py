@@ -11,13 +11,14 @@ from ..compare.text import divergence_sentence, divergence_short
 from .runs import RunView
 
 
-def _scene_line(scene: Scene, t_max: float) -> str:
+def _scene_line(scene: Scene, t_max: float, t_ref: float) -> str:
     b = scene.body
     shape = "rod" if b.n == 2 else f"{b.n}-gon"
+    why = " (the reference's end + 10 %)" if t_max > t_ref else ""
     return (
         f"{shape} on {scene.ground.kind.replace('_', '-')} ground, ρ = {b.gyration:g}, "
-        f"γ = {scene.restitution:g}, g = {scene.gravity:g}; recorded to t = {t_max:.4g} s "
-        "(the reference's end + 10 %)."
+        f"γ = {scene.restitution:g}, g = {scene.gravity:g}; recorded to t = {t_max:.4g} s"
+        f"{why}."
     )
 
 
@@ -63,7 +64,7 @@ def summary_markdown(runs: list[RunView], scene: Scene, t_max: float) -> str:
     lines = [
         f"# {scene.name}",
         "",
-        _scene_line(scene, t_max),
+        _scene_line(scene, t_max, float(runs[0].trajectory.t_final)),
         "",
         _reference_line(runs[0]),
         "",
