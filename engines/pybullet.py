@@ -57,13 +57,15 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import pybullet as pb
 
 from engines.base import build_trajectory
+from engines.quiet import quiet_import
 from reference import quaternion as qt
 from reference.geometry import energies, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
+
+pb = quiet_import("pybullet")  # it prints its build time to the terminal on import
 
 PROFILES = ("tuned", "default")
 ENGINE_NAMES = {"tuned": "pybullet", "default": "pybullet-default"}

@@ -1,8 +1,11 @@
-"""Files at the edge: Trajectory → Parquet (samples and impacts)."""
+"""Files at the edge: Trajectory → Parquet (samples and impacts); tables → CSV or Parquet
+without ever destroying a user's file."""
 
 from __future__ import annotations
 
 import json
+import os
+import tempfile
 from pathlib import Path
 
 import pyarrow as pa
@@ -48,3 +51,45 @@ def write_trajectory_parquet(traj: Trajectory, path: str | Path) -> Path:
     ipath = path.with_name(path.stem + ".impacts" + (path.suffix or ".parquet"))
     pq.write_table(imp, ipath)
     return path
+
+
+TABLE_SUFFIXES = (".csv", ".parquet")
+
+
+def check_table_path(path: str | Path, force: bool = False) -> Path:
+    """The path a table may be written to: a `.csv` or `.parquet` name, not an existing
+    file unless `force`.  Raises ValueError (bad input) otherwise; meant to be called
+    before any work is done."""
+    p = Path(path)
+    if p.suffix.lower() not in TABLE_SUFFIXES:
+        raise ValueError(f"{p}: the file name must end in .csv or .parquet")
+    if p.exists() and not force:
+        raise ValueError(f"{p} exists; pass --force to replace it")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{p} exists and is not a file")
+    return p
+
+
+def write_table(table: pa.Table, path: str | Path, force: bool = False) -> Path:
+    """Write `table` as CSV or Parquet (by suffix) atomically: into a temporary file in
+    the same folder, then renamed over the name (os.replace), so a reader never sees a
+    half-written file and an interrupted write leaves the old one.  An existing file is
+    replaced only with `force` (`check_table_path`)."""
+    p = check_table_path(path, force)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
+    os.close(fd)
+    try:
+        if p.suffix.lower() == ".csv":
+            import pyarrow.csv as pcsv
+
+            pcsv.write_csv(table, tmp)
+        else:
+            pq.write_table(table, tmp)
+        if p.exists() and not force:  # appeared while we wrote
+            raise ValueError(f"{p} exists; pass --force to replace it")
+        os.replace(tmp, p)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return p

@@ -102,3 +102,76 @@ def test_scenes_lists_every_builtin(capsys):
     out = capsys.readouterr().out
     for name in builtin_names():
         assert name in out
+
+
+def test_selfsimilar_table_names_the_kind_of_every_solution(capsys):
+    assert (
+        main(["analyze", "selfsimilar", "--n", "25", "--gyration", "0.5", "--restitution", "0"])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert (
+        main(
+            [
+                "analyze",
+                "selfsimilar",
+                "--n",
+                "25",
+                "--gyration",
+                "0.5",
+                "--restitution",
+                "0",
+                "--json",
+            ]
+        )
+        == 0
+    )
+    doc = json.loads(capsys.readouterr().out)
+    rows = [line.split() for line in text.splitlines()[3:]]
+    assert len(rows) == len(doc["solutions"]) > 0
+    for row, sol in zip(rows, doc["solutions"], strict=True):
+        assert row[1] == ("trivial" if sol["trivial"] else "nontrivial")
+
+
+def test_progress_is_shown_only_with_verbose_before_or_after_the_command(capsys):
+    argv = ["compare", "near-simultaneous", "--engine", "reference", "--t-end", "0.05"]
+    assert main(argv) == 0
+    quiet = capsys.readouterr()
+    assert quiet.err == "" and "reference" in quiet.out
+    for loud in (["-v", *argv], [*argv, "--verbose"]):
+        assert main(loud) == 0
+        assert "compare: reference:" in capsys.readouterr().err
+
+
+def test_pybullet_banner_does_not_reach_the_terminal():
+    """PyBullet prints its build time from C on import; the adapter imports it quietly."""
+    plain = subprocess.run(
+        [sys.executable, "-c", "import pybullet"], capture_output=True, text=True, timeout=60
+    )
+    assert "build time" in plain.stdout + plain.stderr  # the banner this test is about
+    quiet = subprocess.run(
+        [sys.executable, "-c", "import engines.pybullet; print('ok')"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert (quiet.stdout, quiet.stderr) == ("ok\n", "")
+
+
+def test_figures_summary_says_for_each_claim_whether_it_was_reproduced():
+    from harness.figures import format_figures
+
+    doc = {
+        "a": {"agree": True, "headline": "c = 2.01 (paper: 2)", "ours": "x"},
+        "b": {"agree": False, "note": "only in part", "headline": "1 of 3", "ours": "x"},
+        "c": {"agree": False, "ours": "c = 3.5 (paper: 2) " * 10},
+    }
+    text = format_figures(doc, Path("out"))
+    lines = text.splitlines()
+    assert max(map(len, lines)) <= 100
+    assert any(
+        line.split() == ["reproduced", "a:", "c", "=", "2.01", "(paper:", "2)"] for line in lines
+    )
+    assert any(line.strip().startswith("partly  b: 1 of 3") for line in lines)
+    assert any(line.strip().startswith("NOT reproduced  c: c = 3.5") for line in lines)
+    assert "{" not in text

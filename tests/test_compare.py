@@ -124,9 +124,112 @@ def test_table_has_one_row_per_run(calls):
     rows = [
         f
         for f in map(str.split, text.splitlines())
-        if f[:2] in (["pybullet", "0.001"], ["mujoco", "0.001"])
+        if f[:2] in (["pybullet", "1e-03"], ["mujoco", "1e-03"]) and f[2] != "failed:"
     ]
     assert len(rows) == 2
+
+
+def test_default_report_fits_100_columns_and_wide_has_every_column(calls):
+    engines = ["pybullet-default", "mujoco-default", "linear", "mujoco"]
+    result = C.compare(resolve_scene("pentagon-bounce"), engines, dts=[1e-3, 1e-4])
+    text = C.format_compare(result)
+    assert max(len(line) for line in text.splitlines()) <= 100
+    wide = C.format_compare(result, wide=True)
+    header = next(line for line in wide.splitlines() if line.startswith("engine"))
+    for column in ("status", "tails", "t_err[s]", "E_err", "att_err[rad]", "e_eff", "c"):
+        assert column in header.split()
+    assert max(len(line) for line in wide.splitlines()) > 100
+
+
+def test_report_names_who_diverges_first_when_and_why(monkeypatch):
+    """mujoco's second impact is 0.1 s late, linear's first hits another contact: linear
+    diverges first, at its first impact, because of the contact."""
+
+    def fake(engine, scene, dt=None, t_end=None):
+        traj = stand_in(engine, dt)
+        if engine == "mujoco":
+            traj.impacts[1] = ImpactEvent(0.7, 1, 1.0, -0.5, 0.25)
+        if engine == "linear":
+            traj.impacts[0] = ImpactEvent(0.3, 2, 1.0, -1.0, 0.5)
+        return traj
+
+    monkeypatch.setattr(C, "run_simulator", fake)
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco", "linear"], dts=[1e-3])
+    text = C.format_compare(result)
+    first = next(line for line in text.splitlines() if line.startswith("First to diverge"))
+    assert first.startswith("First to diverge: linear at t = 0.3 s")
+    assert "it hit v2 instead" in text
+    mujoco = next(line for line in text.splitlines() if line.startswith("mujoco 1e-03"))
+    assert "1/2" in mujoco and "impact 1 (v1) 0.1 s late" in mujoco
+    doc = result.to_dict()
+    assert doc["first_to_diverge"]["engine"] == "linear"
+    assert doc["engines"][0]["first_mismatch"]["kind"] == "time"
+    assert doc["engines"][1]["first_mismatch"]["kind"] == "contact"
+    assert doc["engines"][0]["verdict"].startswith("mujoco 1e-03: 1/2 impacts matched")
+
+
+def test_no_exponent_for_runs_that_did_not_reach_the_singularity(calls):
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    row = result.to_dict()["engines"][0]
+    assert row["exponent"]["c"] is None and "t_end" in row["exponent"]["reason"]
+
+
+# ----------------------------------------------------------------------------- --out
+
+
+def _diff(tmp_path, calls, name="diff.csv"):
+    from harness.compare.diff import impact_diff
+    from harness.io import write_table
+
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco", "linear"], dts=[1e-3])
+    return write_table(impact_diff(result), tmp_path / name), result
+
+
+def test_impact_diff_pairs_every_reference_impact_with_the_run_impact(tmp_path, calls):
+    import pyarrow.csv as pcsv
+
+    path, result = _diff(tmp_path, calls)
+    table = pcsv.read_csv(path).to_pylist()
+    assert len(table) == 2 * len(result.reference.impacts)  # two runs × two impacts
+    row = table[1]
+    assert (row["run"], row["reference_impact"], row["status"]) == ("mujoco 1e-03", 1, "matched")
+    assert row["reference_t"] == 0.6 and row["run_t"] == pytest.approx(0.601)
+    assert row["d_t"] == pytest.approx(1e-3)
+    assert row["d_v_normal_pre"] == 0.0 and row["run_contact"] == row["reference_contact"] == 1
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp file left
+
+
+def test_impact_diff_marks_the_first_mismatch_and_what_follows(monkeypatch, tmp_path):
+    from harness.compare.diff import impact_diff
+
+    def fake(engine, scene, dt=None, t_end=None):
+        traj = stand_in(engine, dt)
+        if engine == "mujoco":
+            traj.impacts[0] = ImpactEvent(0.3, 3, 1.0, -1.0, 0.5)
+        return traj
+
+    monkeypatch.setattr(C, "run_simulator", fake)
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    rows = impact_diff(result).to_pylist()
+    assert [r["status"] for r in rows] == ["mismatch", "after_divergence"]
+    assert rows[0]["mismatch_kind"] == "contact" and rows[0]["run_contact"] == 3
+    assert rows[1]["run_t"] is None and rows[1]["d_t"] is None
+
+
+def test_out_refuses_to_overwrite_unless_forced_and_writes_parquet(tmp_path, calls, capsys):
+    import pyarrow.parquet as pq
+
+    from harness.cli import main
+
+    out = tmp_path / "diff.parquet"
+    out.write_text("a user's file")
+    argv = ["compare", "pentagon-bounce", "--engine", "mujoco", "--dt", "1e-3", "--out", str(out)]
+    assert main(argv) == 2
+    assert "exists" in capsys.readouterr().err and out.read_text() == "a user's file"
+    assert calls == []  # refused before running anything
+    assert main([*argv, "--force"]) == 0
+    assert pq.read_table(out).num_rows == 2
+    assert main(["compare", "pentagon-bounce", "--engine", "mujoco", "--out", "x.txt"]) == 2
 
 
 # ----------------------------------------------------------------------------- real runs

@@ -402,62 +402,61 @@ def test_trajectory_exponent_recovers_a_power_law_beyond_the_clock_resolution(c)
     """100 impacts down to 0.5^99 ≈ 1.6e-30 before t_f = 4: the intervals below the
     double-double clock's resolution (~1e-28 t) are left out, and t_f − t_K (below an
     ulp of t_f) is extrapolated, not taken from t_singularity."""
-    from harness.sweep.run import trajectory_exponent
+    from reference.exponent import trajectory_exponent
 
     fit = trajectory_exponent(_power_law_trajectory(c, 1.7, 4.0), min_decades=4)
-    assert fit["c"] == pytest.approx(c, rel=1e-9)
-    assert fit["remainder_from"] == "extrapolated"
-    assert 85 < fit["n_used"] < 100
+    assert fit.c == pytest.approx(c, rel=1e-9)
+    assert fit.t_f_source == "extrapolated"
+    assert 85 < fit.n_used < 100
 
 
 @pytest.mark.parametrize("c", [2.0, 3.1])
 def test_trajectory_exponent_uses_a_resolved_t_singularity(c):
-    from harness.sweep.run import trajectory_exponent
+    from reference.exponent import trajectory_exponent
 
     fit = trajectory_exponent(_power_law_trajectory(c, 1.7, 4.0, k=30))
-    assert fit["remainder_from"] == "t_singularity" and fit["n_used"] == 30
-    assert fit["c"] == pytest.approx(c, rel=1e-9)
+    assert fit.t_f_source == "t_singularity" and fit.n_used == 30
+    assert fit.c == pytest.approx(c, rel=1e-9)
 
 
 def test_trajectory_exponent_needs_enough_decades():
-    from harness.sweep.run import trajectory_exponent
+    from reference.exponent import trajectory_exponent
 
     fit = trajectory_exponent(_power_law_trajectory(0.4, 1.0, 4.0))  # window 5.96 decades
-    assert fit["c"] is None and 5.5 < fit["fit_decades"] < 6
+    assert fit.c is None and 5.5 < fit.fit_decades < 6
 
 
 def test_trajectory_exponent_without_t_singularity_uses_the_last_impact():
-    from harness.sweep.run import trajectory_exponent
+    from reference.exponent import trajectory_exponent
 
     # t_f taken at the last used impact: time-to-go 0.5^i − 0.5^K, still E ∝ ttg^c to
     # within the window (the last decades are left out)
     fit = trajectory_exponent(_power_law_trajectory(2.0, 1.0, 4.0, with_tsing=False))
-    assert fit["remainder_from"] == "last_impact"
-    assert fit["c"] == pytest.approx(2.0, rel=1e-3)
+    assert fit.t_f_source == "last_impact"
+    assert fit.c == pytest.approx(2.0, rel=1e-3)
 
 
 def test_trajectory_exponent_on_excess_energy_matches_the_linear_model():
     """Cross-method on one run: the exact reference (energy above the floor set by its
     invariants) against the linear model's own estimator, same initial state, where
     gravity keeps the motion self-similar (c = 2, paper section 3.4)."""
-    from harness.sweep.run import excess_energy_at, polygon_scene, trajectory_exponent
+    from harness.sweep.run import polygon_scene
     from reference import ReferenceOptions, simulate
+    from reference.exponent import excess_energy_of, trajectory_exponent
     from reference.linear.simulate import run_linear_exponent
 
     cfg = small_config(engine="reference")
     q0, p0 = paper_initial_state(0, 3, 0, 0)
     scene = polygon_scene(cfg, 0.1, 0.7, q0, p0)
     # 21 decades of energy (the default floor stops at 18): the fit then spans as many
-    # decades as the linear model's own
+    # decades as the linear model's own (the estimator leaves out the first 3 and last 2)
     traj = simulate(scene, t_end=50.0, options=ReferenceOptions(energy_floor=1e-21))
-    fit = trajectory_exponent(traj, energy_at=excess_energy_at(traj, scene))
+    fit = trajectory_exponent(traj, energy=excess_energy_of(traj, scene))
     lin = run_linear_exponent(3, 0.1, 0.7, q0, p0)
     assert traj.status is Status.SINGULARITY and lin["status"] == "singularity"
-    # the run ends at energy_floor = 1e-21 of the initial excess: 21 decades, of which the
-    # estimator leaves out the first 3 and the last 2
-    assert fit["fit_decades"] > 15
-    assert fit["c"] == pytest.approx(lin["c"], abs=0.01)
-    assert abs(fit["c"] - 2.0) < 0.1
+    assert fit.fit_decades > 15
+    assert fit.c == pytest.approx(lin["c"], abs=0.01)
+    assert abs(fit.c - 2.0) < 0.1
 
 
 def test_reference_simulator_sample_agrees_with_the_linear_model(tmp_path):

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import math
 import sys
 from typing import Any
+
+LOGGERS = ("harness", "engines", "reference")  # ours: INFO with -v/--verbose
 
 
 class BadInput(Exception):
@@ -64,8 +67,39 @@ def emit(doc: Any, as_json: bool, text: str) -> None:
         print(text)
 
 
+def configure_logging(verbose: bool) -> None:
+    """Our loggers write bare lines to stderr: warnings always, progress (INFO) only with
+    -v/--verbose.  Third-party loggers keep Python's default (warnings and above)."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    for name in LOGGERS:
+        logger = logging.getLogger(name)
+        logger.handlers[:] = [handler]
+        logger.setLevel(logging.INFO if verbose else logging.WARNING)
+        logger.propagate = False
+
+
 def log(msg: str) -> None:
+    """Progress and diagnostics: stderr, shown with -v/--verbose."""
+    logging.getLogger("harness").info(msg)
+
+
+def note(msg: str) -> None:
+    """What the user must see whatever the verbosity (a file written, a run left out):
+    one line on stderr."""
     print(msg, file=sys.stderr, flush=True)
+
+
+def add_verbose(parser: argparse.ArgumentParser, top: bool = False) -> None:
+    """-v/--verbose on a parser.  Sub-commands take it too (`harness compare X -v`), with
+    no default of their own so that they do not reset the top-level flag."""
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        default=False if top else argparse.SUPPRESS,
+        help="show progress and diagnostics on stderr",
+    )
 
 
 def finite(x: Any) -> Any:

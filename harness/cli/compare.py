@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import emit, load_scene_arg, log, positive_float
+from .common import BadInput, emit, load_scene_arg, log, note, positive_float
 
 
 def register(sub) -> None:
@@ -13,6 +13,17 @@ def register(sub) -> None:
     c.add_argument("--t-end", type=positive_float)
     c.add_argument("--scale", type=positive_float)
     c.add_argument("--record", metavar="FILE.rrd")
+    c.add_argument(
+        "--wide",
+        action="store_true",
+        help="every column in the terminal table (wider than 100 characters)",
+    )
+    c.add_argument(
+        "--out",
+        metavar="FILE",
+        help="write the impact-by-impact diff to FILE (.csv or .parquet; docs/output.md)",
+    )
+    c.add_argument("--force", action="store_true", help="let --out replace an existing file")
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=run)
 
@@ -23,16 +34,28 @@ def run(args) -> int:
 
     for e in args.engine:
         check_engine(e)
+    if args.out:
+        from ..io import check_table_path
+
+        try:  # before minutes of simulation, not after
+            check_table_path(args.out, args.force)
+        except ValueError as exc:
+            raise BadInput(str(exc)) from None
     scene = load_scene_arg(args)
     result = compare(scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log)
     if args.record:
-        from ..recording import record_trajectories
+        from ..recording import record_comparison
 
-        runs = [r.trajectory for r in result.runs if r.trajectory.n_samples > 0]
-        skipped = len(result.runs) - len(runs)
-        if skipped:
-            log(f"recording leaves out {skipped} run(s) that produced no samples")
-        path = record_trajectories([result.reference, *runs], args.record, scene=scene)
-        log(f"wrote {path}")
-    emit(result.to_dict(), args.json, format_compare(result))
+        path = record_comparison(result, args.record, note=note)
+        note(f"wrote {path}")
+    if args.out:
+        from ..compare.diff import impact_diff
+        from ..io import write_table
+
+        try:
+            path = write_table(impact_diff(result), args.out, force=args.force)
+        except ValueError as exc:
+            raise BadInput(str(exc)) from None
+        note(f"wrote {path}")
+    emit(result.to_dict(), args.json, format_compare(result, wide=args.wide))
     return 0

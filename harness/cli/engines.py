@@ -8,7 +8,7 @@ named with the reason on stderr; the others are still listed).
 
 from __future__ import annotations
 
-from .common import emit, log
+from .common import emit, note
 
 
 def register(sub) -> None:
@@ -82,5 +82,5 @@ def run(args) -> int:
     emit({"group": GROUP, "engines": rows}, args.json, text)
     broken = [r for r in rows if r["error"] is not None]
     for r in broken:
-        log(f"harness: error: {r['error']}")
+        note(f"harness: error: {r['error']}")
     return 2 if broken else 0

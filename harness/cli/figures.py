@@ -15,8 +15,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..figures import make_figures
+    from ..figures import format_figures, make_figures
 
     doc = make_figures(Path(args.out), progress=log)
-    emit(doc, args.json, "\n".join(f"{k}: {v}" for k, v in doc.items()))
+    emit(doc, args.json, format_figures(doc, Path(args.out)))
     return 0

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import emit, load_scene_arg, log, positive_float
+from .common import emit, load_scene_arg, note, positive_float
 
 
 def register(sub) -> None:
@@ -29,11 +29,11 @@ def run(args) -> int:
         from ..io import write_trajectory_parquet
 
         write_trajectory_parquet(traj, args.out)
-        log(f"wrote {args.out}")
+        note(f"wrote {args.out}")
     if args.record:
         from ..recording import record_trajectories
 
         path = record_trajectories([traj], args.record, scene=scene)
-        log(f"wrote {path}")
+        note(f"wrote {path}")
     emit(traj.summary(with_impacts=True), args.json, format_simulate(traj))
     return 0

@@ -2,9 +2,15 @@
 
 The reference runs once; every other simulator runs at every timestep given (fixed-step
 engines) or once (`reference`, `linear`: event-driven, dt does not apply).  Each run is
-scored by `harness.metrics.evaluate`.  An engine that raises is recorded as a run with
-status `failed` and the exception as its message, so one broken engine does not hide the
-others' results; bad input (`SceneError`) still stops the command.
+scored by `harness.metrics.evaluate`, and gets an energy exponent c only if it reached
+the end of the motion (`harness.metrics.run_exponent`).  An engine that raises is
+recorded as a run with status `failed` and the exception as its message, so one broken
+engine does not hide the others' results; bad input (`SceneError`) still stops the
+command.
+
+Text output: `text.format_compare` (100 columns, one verdict line per run; `wide=True`
+for every column); the impact-by-impact diff: `diff.impact_diff` (`--out`).  The columns
+are defined in docs/output.md.
 """
 
 from __future__ import annotations
@@ -14,31 +20,29 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
+from reference.exponent import ExponentFit
 from reference.scene import Scene, SceneError
-from reference.trajectory import Status, Trajectory
+from reference.trajectory import Trajectory
 
-from ..metrics import (
-    RELATIVE_TIME_TOLERANCE,
-    STEPS_TIME_TOLERANCE,
-    RunMetrics,
-    effective_restitution,
-    evaluate,
-)
+from ..metrics import RunMetrics, effective_restitution, evaluate, run_exponent
 from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator
-from ..text import table
 
 
 @dataclass
 class EngineRun:
-    """One simulator run and its metrics against the reference."""
+    """One simulator run, its metrics against the reference and its exponent."""
 
     engine: str
     dt: float | None
     trajectory: Trajectory
     wall_time_s: float
     metrics: RunMetrics
+    exponent: ExponentFit
+
+    @property
+    def label(self) -> str:
+        """'mujoco 1e-04' for fixed-step runs, the engine name otherwise."""
+        return self.engine if self.dt is None else f"{self.engine} {self.dt:.0e}"
 
     def to_dict(self) -> dict[str, Any]:
         traj = self.trajectory
@@ -51,6 +55,7 @@ class EngineRun:
             "t_final": traj.t_final,
         }
         doc.update(self.metrics.to_dict())
+        doc["exponent"] = self.exponent.to_dict()
         return doc
 
 
@@ -60,18 +65,43 @@ class CompareResult:
     reference: Trajectory
     reference_wall_time_s: float
     runs: list[EngineRun]
+    reference_exponent: ExponentFit | None = None
+
+    def first_to_diverge(self) -> EngineRun | None:
+        """The run whose first divergence from the reference comes earliest (None if
+        no run diverges)."""
+        diverged = [r for r in self.runs if r.metrics.first_divergence_time is not None]
+        return min(diverged, key=lambda r: r.metrics.first_divergence_time, default=None)
 
     def to_dict(self) -> dict[str, Any]:
-        """The contract's `compare` document."""
+        """The contract's `compare` document, plus the exponents and the verdicts."""
+        from .text import divergence_sentence, verdict_line
+
         ref = self.reference.summary(with_impacts=False)
         ref["wall_time_s"] = self.reference_wall_time_s
         r = effective_restitution(self.reference, self.scene.gravity)
         ref["effective_restitution"] = r.median
+        if self.reference_exponent is not None:
+            ref["exponent"] = self.reference_exponent.to_dict()
+        first = self.first_to_diverge()
+        engines = []
+        for run in self.runs:
+            row = run.to_dict()
+            row["verdict"] = verdict_line(run, self.scene)
+            engines.append(row)
         return {
             "scene": self.scene.name,
             "restitution": self.scene.restitution,
             "reference": ref,
-            "engines": [run.to_dict() for run in self.runs],
+            "engines": engines,
+            "first_to_diverge": None
+            if first is None
+            else {
+                "engine": first.engine,
+                "dt": first.dt,
+                "t": first.metrics.first_divergence_time,
+                "why": divergence_sentence(first, self.scene),
+            },
         }
 
 
@@ -98,8 +128,9 @@ def compare(
                 traj, wall = _timed_run(engine, scene, dt, t_end)
                 say(_progress_line(engine, dt, traj, wall))
             metrics = evaluate(traj, reference, scene.gravity)
-            runs.append(EngineRun(engine, dt, traj, wall, metrics))
-    return CompareResult(scene, reference, ref_wall, runs)
+            fit = run_exponent(traj, scene, reference, metrics.match)
+            runs.append(EngineRun(engine, dt, traj, wall, metrics, fit))
+    return CompareResult(scene, reference, ref_wall, runs, run_exponent(reference, scene))
 
 
 def _timed_run(
@@ -121,89 +152,13 @@ def _progress_line(engine: str, dt: float | None, traj: Trajectory, wall: float)
     label = engine if dt is None else f"{engine} dt={dt:g}"
     text = f"compare: {label}: {traj.status.value}, {len(traj.impacts)} impacts, "
     text += f"t_final={traj.t_final:.6g} ({wall:.2f} s)"
-    if traj.status is Status.FAILED and traj.message:
+    if traj.status.value == "failed" and traj.message:
         text += f": {traj.message}"
     return text
 
 
-# ----------------------------------------------------------------------------- text
+def format_compare(result: CompareResult, wide: bool = False) -> str:
+    """The terminal report (harness.compare.text)."""
+    from .text import format_compare as _format
 
-
-def _num(x: float | None, fmt: str = ".2e") -> str:
-    return "-" if x is None or not np.isfinite(x) else format(x, fmt)
-
-
-def format_compare(result: CompareResult) -> str:
-    """A readable table: one row per run, then the rules behind the columns."""
-    ref = result.reference
-    scene = result.scene
-    lines = [
-        f"scene      {scene.name}  (n={scene.body.n}, {scene.ground.kind}, "
-        f"gamma={scene.restitution:g})",
-        f"reference  {ref.status.value}: t_final={ref.t_final:.6g}, "
-        f"{len(ref.impacts)} impacts, {result.reference_wall_time_s:.2f} s"
-        + (f", t_sing={ref.t_singularity:.10g}" if ref.t_singularity is not None else ""),
-        "",
-    ]
-    header = [
-        "engine",
-        "dt",
-        "status",
-        "wall[s]",
-        "impacts",
-        "matched",
-        "tails",
-        "t_err[s]",
-        "E_err",
-        "E_err<div",
-        "att_err[rad]",
-        "att<div",
-        "diverge[s]",
-        "e_eff",
-    ]
-    rows = []
-    for run in result.runs:
-        m = run.metrics
-        r = m.restitution
-        e_eff = "-" if r.median is None else f"{r.median:.4f} (n={r.n})"
-        rows.append(
-            [
-                run.engine,
-                "-" if run.dt is None else f"{run.dt:g}",
-                run.trajectory.status.value,
-                f"{run.wall_time_s:.2f}",
-                str(m.impacts),
-                f"{m.impacts_matched}/{m.reference_impacts}",
-                f"{m.skipped_reference}/{m.skipped_run}",
-                _num(m.impact_time_error),
-                _num(m.energy_error),
-                _num(m.energy_error_agreeing),
-                _num(m.attitude_error),
-                _num(m.attitude_error_agreeing),
-                _num(m.first_divergence_time, ".4g"),
-                e_eff,
-            ]
-        )
-    lines.append(table(rows, header))
-    lines += [
-        "",
-        f"matched: leading impacts with the reference's contact and time, |dt| <= "
-        f"{STEPS_TIME_TOLERANCE:g} steps (1e-9 s event-driven) + "
-        f"{RELATIVE_TIME_TOLERANCE:g}*t, capped at half the gap to the next same-contact "
-        "reference impact; of the reference impacts in the common window",
-        "tails: chatter-tail impacts skipped (reference/run): approach slower than "
-        "max(10 g dt, 1% of the fastest), at a contact already in the chatter episode",
-        "E_err: max |E - E_ref|/E_ref(0) away from impacts; att_err: max attitude angle; "
-        "<div: the same before the first divergence",
-        "diverge: first impact mismatch or attitude error > 0.1 x max reference tilt; "
-        "e_eff: median -v_post/v_pre of the run's impacts approaching faster than "
-        "max(10 g dt, 1% of the fastest)",
-    ]
-    for run in result.runs:
-        m = run.metrics
-        label = run.engine if run.dt is None else f"{run.engine} dt={run.dt:g}"
-        if m.divergence_reason:
-            lines.append(f"  {label}: {m.divergence_reason}")
-        if run.trajectory.status is Status.FAILED and run.trajectory.message:
-            lines.append(f"  {label}: failed: {run.trajectory.message}")
-    return "\n".join(lines)
+    return _format(result, wide=wide)

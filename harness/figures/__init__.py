@@ -25,6 +25,14 @@ from reference.linear.model import LinearModel
 from reference.linear.selfsimilar import selfsimilar_solutions
 from reference.linear.simulate import run_linear, run_linear_exponent
 
+# Axis labels.  The models are dimensionless with a = m = g = 1: lengths in a, times in
+# √(a/g), energies in m g a; ratios carry [–].
+RHO = "ρ = radius of gyration / a  [–]"
+GAMMA = "γ, coefficient of restitution  [–]"
+BETA = "β, ratio of successive impact intervals  [–]"
+TIME_TO_GO = "t_f − t  [√(a/g)]"
+ENERGY = "E before each impact  [m g a]"
+
 
 def _plt():
     import matplotlib
@@ -57,7 +65,7 @@ def _scatter_betas(ax, xs, sols_list, xlabel):
             else:
                 ax.plot(x, s.beta, "o", mfc="none", color="tab:gray", ms=3)
     ax.set_xlabel(xlabel)
-    ax.set_ylabel("β")
+    ax.set_ylabel(BETA)
     ax.set_ylim(0, 1.02)
 
 
@@ -79,7 +87,7 @@ def fig_beta_vs_rho(out: Path, progress) -> dict:
     for ax, n in zip(axes, (3, 25), strict=True):
         progress(f"  beta_vs_rho n={n}")
         sols = [_solutions(n, float(r), 0.0) for r in rhos]
-        _scatter_betas(ax, rhos, sols, "ρ")
+        _scatter_betas(ax, rhos, sols, RHO)
         ax.set_title(f"n = {n}, γ = 0")
         _legend(ax)
         small = [s for s in sols[0] if s.trivial]
@@ -94,6 +102,7 @@ def fig_beta_vs_rho(out: Path, progress) -> dict:
                 float(r) for r, ss in zip(rhos, sols, strict=True) if any(s.feasible for s in ss)
             ],
         }
+    fig.suptitle("Self-similar motions of the plastic polygon (γ = 0): β against ρ")
     path = _save(fig, out / "beta_vs_rho.png")
     f3, f25 = facts[3], facts[25]
     ours = (
@@ -111,6 +120,9 @@ def fig_beta_vs_rho(out: Path, progress) -> dict:
         "large enough ρ when n > 3",
         "ours": ours,
         "agree": bool(agree and not f3["rho_without_nontrivial"]),
+        "headline": f"trivial β at small ρ: {f3['trivial_at_small_rho']} for n = 3, "
+        f"{f25['trivial_at_small_rho']} for n = 25 (paper: 1, 2); n = 3 has no nontrivial β in "
+        f"(0, 1) at {len(f3['rho_without_nontrivial'])} of {len(rhos)} ρ",
         "note": "disagree only in part: for n = 3, γ = 0 the nontrivial roots of N(β) "
         "lie outside (0, 1) over most of the ρ range"
         if f3["rho_without_nontrivial"]
@@ -130,9 +142,9 @@ def fig_feasibility_border(out: Path, progress) -> dict:
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(ns, border, "o-")
     ax.axhline(0.5, color="k", lw=0.8, ls=":", label="homogeneous disk ρ ≈ 1/2")
-    ax.set_xlabel("n")
-    ax.set_ylabel("smallest ρ with a feasible self-similar motion (γ = 0)")
-    ax.set_title("feasible above the curve (grid step 0.01)")
+    ax.set_xlabel("n, number of vertices  [–]")
+    ax.set_ylabel("smallest feasible ρ  [–]")
+    ax.set_title("Feasible self-similar motion (γ = 0) above the curve (ρ step 0.01)")
     ax.legend(fontsize=8)
     path = _save(fig, out / "feasibility_border.png")
     ok = all(b < 0.5 for n, b in zip(ns, border, strict=True) if n > 3)
@@ -142,6 +154,8 @@ def fig_feasibility_border(out: Path, progress) -> dict:
         "ours": "smallest feasible ρ: "
         + ", ".join(f"n={n}: {b:.2f}" for n, b in zip(ns, border, strict=True)),
         "agree": bool(ok),
+        "headline": "smallest feasible ρ (γ = 0) for n > 3: at most "
+        f"{max(b for n, b in zip(ns, border, strict=True) if n > 3):.2f} (paper: below 1/2)",
     }
 
 
@@ -153,10 +167,11 @@ def fig_beta_vs_gamma(out: Path, progress) -> dict:
     for ax, (n, rho) in zip(axes.flat, [(3, 0.25), (3, 0.5), (25, 0.25), (25, 0.5)], strict=True):
         progress(f"  beta_vs_gamma n={n} rho={rho}")
         sols = [_solutions(n, rho, float(g)) for g in gammas]
-        _scatter_betas(ax, gammas, sols, "γ")
+        _scatter_betas(ax, gammas, sols, GAMMA)
         ax.set_title(f"n = {n}, ρ = {rho}")
         multi += [(n, rho, float(g)) for g, ss in zip(gammas, sols, strict=True) if len(ss) > 1]
     _legend(axes.flat[0])
+    fig.suptitle("Self-similar motions with restitution: β against γ")
     path = _save(fig, out / "beta_vs_gamma.png")
     return {
         "path": str(path),
@@ -165,6 +180,8 @@ def fig_beta_vs_gamma(out: Path, progress) -> dict:
         "ours": f"{len(multi)} of {4 * len(gammas)} (n, ρ, γ) points have more than one "
         "self-similar β (trivial or not)",
         "agree": bool(multi),
+        "headline": f"{len(multi)} of {4 * len(gammas)} (n, ρ, γ) points have more than one "
+        "self-similar β (paper: several in some cases)",
     }
 
 
@@ -200,8 +217,9 @@ def fig_boundaries(out: Path, progress) -> dict:
     ax.plot([], [], "k-.", label="feasible above")
     ax.plot([], [], "k--", label="stable (feasible) left of")
     ax.plot([], [], "k-", label="trivial below")
-    ax.set_xlabel("γ")
-    ax.set_ylabel("ρ")
+    ax.set_xlabel(GAMMA)
+    ax.set_ylabel(RHO)
+    ax.set_title("Self-similar motion: existence, feasibility and stability over (γ, ρ)")
     ax.legend(fontsize=7, loc="upper right")
     path = _save(fig, out / "boundaries.png")
     return {
@@ -212,6 +230,8 @@ def fig_boundaries(out: Path, progress) -> dict:
         f"solutions; γ = 0, ρ ≤ 1/√2: feasible but unstable at {g0_unstable or 'none'} "
         "(outside: n = 3 for ρ ≥ 0.71, n = 4 for ρ ≥ 0.78, n = 5 for ρ ≥ 1.34)",
         "agree": bool(not rho05_stable and not g0_unstable),
+        "headline": f"stable feasible solutions at ρ = 0.5, γ > 0: {len(rho05_stable)}; "
+        f"unstable feasible ones at γ = 0, ρ ≤ 1/√2: {len(g0_unstable)} (paper: none, none)",
     }
 
 
@@ -241,11 +261,12 @@ def fig_energy_precession(out: Path, progress) -> dict:
         ax.loglog(ttg, pe, "-", lw=0.6, color="tab:blue", label="potential")
         ref = (ke[0] + pe[0]) * (ttg / ttg[0]) ** 2
         ax.loglog(ttg, ref, ":", color="gray", label="slope 2")
-        ax.set_title(f"n = {n}, γ = {g}, ρ = 0.5: c = {ex['c']:.3f} ± {ex['c_spread']:.3f}")
-        ax.set_xlabel("t_f − t")
-        ax.set_ylabel("energy before impact")
+        ax.set_title(f"n = {n}, γ = {g}, ρ = 0.5: c = {ex['c']:.3f} ± {ex['c_stderr']:.1g}")
+        ax.set_xlabel(TIME_TO_GO)
+        ax.set_ylabel(ENERGY)
         cs.append((n, g, ex["c"], ex["c_decades"]))
     axes.flat[0].legend(fontsize=7)
+    fig.suptitle("Perturbed self-similar motion drifts into precession; c ± its standard error")
     path = _save(fig, out / "energy_precession.png", dpi=110)
     worst = max(abs(c - 2) for _, _, c, _ in cs)
     return {
@@ -255,6 +276,8 @@ def fig_energy_precession(out: Path, progress) -> dict:
         "ours": "c (regression / decades): "
         + "; ".join(f"n={n} γ={g}: {c:.3f}/{d:.3f}" for n, g, c, d in cs),
         "agree": bool(worst < 0.05),
+        "headline": f"c of perturbed self-similar motion: {min(c for _, _, c, _ in cs):.3f} … "
+        f"{max(c for _, _, c, _ in cs):.3f} over {len(cs)} runs (paper: 2)",
     }
 
 
@@ -272,7 +295,7 @@ def fig_rod_clin(out: Path, progress) -> dict:
                 C[i, j] = c_lin(*b)
     fig, ax = plt.subplots(figsize=(6.5, 5))
     im = ax.pcolormesh(gammas, psis, np.log10(C), shading="auto", cmap="viridis", vmin=-2, vmax=1)
-    fig.colorbar(im, ax=ax, label="log10 c_lin")
+    fig.colorbar(im, ax=ax, label="log10 c_lin  [–]")
     cs = ax.contour(gammas, psis, C, levels=[0.5, 1, 2], colors="w", linewidths=0.8)
     ax.clabel(cs, fontsize=7)
     ax.plot(gammas, 2 * np.sqrt(gammas) / (1 + gammas), "r-", lw=1, label="CC boundary (no g)")
@@ -283,8 +306,9 @@ def fig_rod_clin(out: Path, progress) -> dict:
         lw=1,
         label="Or's condition (with g)",
     )
-    ax.set_xlabel("γ")
-    ax.set_ylabel("ψ = (1 − ρ²)/(1 + ρ²)")
+    ax.set_xlabel(GAMMA)
+    ax.set_ylabel("ψ = (1 − ρ²)/(1 + ρ²)  [–]")
+    ax.set_title("Falling rod (n = 2) without gravity: energy exponent c_lin")
     ax.legend(fontsize=7, loc="lower right")
     path = _save(fig, out / "rod_clin.png")
     # checks: on Or's boundary c_lin = 2; near the CC boundary large; small at γ, ρ → 0
@@ -303,6 +327,8 @@ def fig_rod_clin(out: Path, progress) -> dict:
         "paper": "c_lin → ∞ at the CC boundary, → 0 as γ → 0 or ρ → 0, = 2 on Or's boundary",
         "ours": ours,
         "agree": bool(abs(on_or - 2) < 1e-6 and near_cc > 10 and small < 0.05),
+        "headline": f"c_lin = {on_or:.6f} on Or's boundary (paper: 2), {near_cc:.0f} just "
+        f"above the CC boundary (paper: → ∞), {small:.2g} at γ = ρ = 0.01 (paper: → 0)",
     }
 
 
@@ -353,8 +379,9 @@ def fig_triangle_c_vs_clin(out: Path, progress, samples: int = 20) -> dict:
     ax.plot([], [], "kx", label="one run down 290 decades (asymptote)")
     ax.axhline(2, color="gray", lw=0.5)
     ax.set_yscale("log")
-    ax.set_xlabel("γ")
-    ax.set_ylabel("c")
+    ax.set_xlabel(GAMMA)
+    ax.set_ylabel("energy exponent c  [–]")
+    ax.set_title("Triangle (n = 3): simulated exponent c against c_lin")
     ax.legend(fontsize=7)
     path = _save(fig, out / "triangle_c_vs_clin.png")
     rel = [abs(c - cl) / cl for _, _, c, cl, _ in rows]
@@ -374,6 +401,13 @@ def fig_triangle_c_vs_clin(out: Path, progress, samples: int = 20) -> dict:
         "paper": "in the CC-not-PCC region the simulated c is close to c_lin and mostly below 2",
         "ours": ours,
         "agree": bool(rows) and float(np.median(rel)) < 0.1,
+        "headline": (
+            f"CC-not-PCC region: median |c − c_lin|/c_lin = {np.median(rel):.2f} over "
+            f"{len(rows)} (ρ, γ) points, c < 2 at {sum(c < 2 for _, _, c, _, _ in rows)} "
+            "(paper: c close to c_lin, mostly below 2)"
+            if rows
+            else "no CC-not-PCC point produced an exponent"
+        ),
         "points": [
             {"rho": r, "gamma": g, "c_mean": c, "c_lin": cl, "n": k} for r, g, c, cl, k in rows
         ],
@@ -392,6 +426,30 @@ FIGURES = {
     "rod_clin": fig_rod_clin,
     "triangle_c_vs_clin": fig_triangle_c_vs_clin,
 }
+
+
+def verdict(doc: dict) -> str:
+    """'reproduced', 'partly' (agrees, with a stated exception) or 'NOT reproduced'."""
+    if not doc["agree"]:
+        return "partly" if doc.get("note") else "NOT reproduced"
+    return "reproduced"
+
+
+def format_figures(doc: dict, out_dir: Path) -> str:
+    """A short human summary: each of the paper's claims, reproduced or not, with the
+    number that decides it (the JSON document has every detail)."""
+    import textwrap
+
+    lines = [f"The paper's claims, recomputed ({len(doc)} figures as PNG in {out_dir}):", ""]
+    for name, d in doc.items():
+        head = f"{verdict(d):>14}  {name}: {d.get('headline') or d['ours']}"
+        lines += textwrap.wrap(head, 100, subsequent_indent=" " * 16)
+        if d.get("note"):
+            lines += textwrap.wrap(
+                d["note"], 100, initial_indent=" " * 16, subsequent_indent=" " * 16
+            )
+    lines += ["", "--json: the paper's statement, our numbers and the data behind each figure."]
+    return "\n".join(lines)
 
 
 def make_figures(out_dir: Path, progress=print) -> dict:

@@ -37,6 +37,7 @@ from .attitude import (  # noqa: F401  (the package's API)
     largest_tilt,
 )
 from .energy import ENERGY_GUARD_STEPS, energy_error, energy_error_series  # noqa: F401
+from .exponent import followed_to_singularity, run_exponent  # noqa: F401
 from .matching import (  # noqa: F401
     EVENT_TIME_TOLERANCE,
     RELATIVE_TIME_TOLERANCE,
@@ -45,6 +46,7 @@ from .matching import (  # noqa: F401
     STEPS_TIME_TOLERANCE,
     ImpactMatch,
     MatchTolerance,
+    Mismatch,
     chatter_tail,
     common_window,
     impact_time_error,
@@ -80,6 +82,12 @@ class RunMetrics:
     skipped_run: int
     common_window: tuple[float, float] | None
     restitution: RestitutionEstimate
+    match: ImpactMatch | None = None
+    divergence_kind: str | None = None  # "attitude" or the Mismatch kind
+
+    @property
+    def first_mismatch(self) -> Mismatch | None:
+        return None if self.match is None else self.match.mismatch
 
     def to_dict(self) -> dict[str, Any]:
         r = self.restitution
@@ -105,6 +113,8 @@ class RunMetrics:
             "effective_restitution_range": list(r.range) if r.range else None,
             "effective_restitution_n": r.n,
             "restitution_speed_threshold": r.speed_threshold,
+            "divergence_kind": self.divergence_kind,
+            "first_mismatch": self.first_mismatch.to_dict() if self.first_mismatch else None,
         }
 
 
@@ -122,6 +132,9 @@ def evaluate(run: Trajectory, reference: Trajectory, gravity: float) -> RunMetri
     threshold = attitude_threshold(run, reference)
     t_div, why = first_divergence_time(run, reference, tol, threshold)
     cut = math.inf if t_div is None else t_div
+    kind = None
+    if t_div is not None:
+        kind = m.mismatch.kind if m.mismatch and t_div == m.mismatch_time else "attitude"
     return RunMetrics(
         impacts=len(run.impacts),
         reference_impacts=m.n_reference,
@@ -140,6 +153,8 @@ def evaluate(run: Trajectory, reference: Trajectory, gravity: float) -> RunMetri
         skipped_run=m.skipped_run,
         common_window=common_window(run, reference),
         restitution=effective_restitution(run, gravity),
+        match=m,
+        divergence_kind=kind,
     )
 
 

@@ -162,6 +162,47 @@ def chatter_tail(traj: Trajectory, speed: float) -> np.ndarray:
 
 
 @dataclass(frozen=True)
+class Mismatch:
+    """Where two impact sequences first disagree (`match_impacts`).
+
+    kind: "contact" (a different contact hit), "time" (same contact, outside the time
+    window), "missed" (the run has no impact where the reference has one) or "spurious"
+    (the run has an impact the reference does not); ref_index / run_index: the impacts
+    compared (None where there is none); t_ref, t_run their times; contact_ref,
+    contact_run their contacts; window: the reference impact's time window (s)."""
+
+    kind: str
+    t: float
+    ref_index: int | None
+    run_index: int | None
+    t_ref: float | None
+    t_run: float | None
+    contact_ref: int | None
+    contact_run: int | None
+    window: float | None
+
+    @property
+    def time_offset(self) -> float | None:
+        """t_run − t_ref (s) where both exist."""
+        if self.t_ref is None or self.t_run is None:
+            return None
+        return self.t_run - self.t_ref
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "kind": self.kind,
+            "t": self.t,
+            "reference_impact": self.ref_index,
+            "run_impact": self.run_index,
+            "t_reference": self.t_ref,
+            "t_run": self.t_run,
+            "contact_reference": self.contact_ref,
+            "contact_run": self.contact_run,
+            "window": self.window,
+        }
+
+
+@dataclass(frozen=True)
 class ImpactMatch:
     """Result of matching a run's impact sequence against the reference's.
 
@@ -169,7 +210,9 @@ class ImpactMatch:
     time_errors: t_run − t_ref of those (signed); mismatch_time: when the sequences
     first disagree inside the common window (None if they agree as far as both go);
     reason: what disagreed; n_reference: reference impacts inside the common window;
-    skipped_reference / skipped_run: chatter-tail impacts passed over."""
+    skipped_reference / skipped_run: chatter-tail impacts passed over; mismatch: the
+    first disagreement in detail; skipped_reference_indices: which reference impacts
+    were passed over."""
 
     pairs: np.ndarray
     time_errors: np.ndarray
@@ -178,6 +221,8 @@ class ImpactMatch:
     n_reference: int
     skipped_reference: int
     skipped_run: int
+    mismatch: Mismatch | None = None
+    skipped_reference_indices: tuple[int, ...] = ()
 
     @property
     def n_matched(self) -> int:
@@ -210,50 +255,69 @@ def match_impacts(run: Trajectory, reference: Trajectory, tolerance: MatchTolera
     n_e = int(np.sum(te <= t_end + float(tolerance.window(t_end))))
     ce, tail_e = run.impact_contacts(), chatter_tail(run, tolerance.tail_speed)
     pairs: list[tuple[int, int]] = []
-    skipped_r = skipped_e = 0
-    mismatch_time: float | None = None
-    reason: str | None = None
+    skipped_r: list[int] = []
+    skipped_e = 0
+    mismatch: Mismatch | None = None
     i = j = 0
     while i < n_r or (j < n_e and te[j] <= t_end):
         if i < n_r and j < n_e:
-            d = te[j] - tr[i]
-            if ce[j] == cr[i] and abs(d) <= wr[i]:
+            if ce[j] == cr[i] and abs(te[j] - tr[i]) <= wr[i]:
                 pairs.append((i, j))
                 i, j = i + 1, j + 1
                 continue
             if tr[i] <= te[j] and tail_r[i]:  # the earlier one is a tail: skip it
-                i, skipped_r = i + 1, skipped_r + 1
+                skipped_r.append(i)
+                i += 1
                 continue
             if te[j] < tr[i] and tail_e[j]:
                 j, skipped_e = j + 1, skipped_e + 1
                 continue
-            mismatch_time = float(min(te[j], tr[i]))
-            if ce[j] != cr[i]:
-                reason = (
-                    f"reference impact {i}: contact {cr[i]} at t={tr[i]:.6g}, "
-                    f"run contact {ce[j]} at t={te[j]:.6g}"
-                )
-            else:
-                reason = (
-                    f"reference impact {i} (contact {cr[i]}): t={tr[i]:.6g}, run "
-                    f"t={te[j]:.6g}, |dt|={abs(d):.3g} > window {wr[i]:.3g}"
-                )
+            kind = "contact" if ce[j] != cr[i] else "time"
+            mismatch = Mismatch(
+                kind, float(min(te[j], tr[i])), i, j, tr[i], te[j], cr[i], ce[j], wr[i]
+            )
         elif i < n_r:
             if tail_r[i]:
-                i, skipped_r = i + 1, skipped_r + 1
+                skipped_r.append(i)
+                i += 1
                 continue
-            mismatch_time = float(tr[i])
-            reason = f"reference impact {i} (contact {cr[i]}, t={tr[i]:.6g}) missed"
+            mismatch = Mismatch("missed", float(tr[i]), i, None, tr[i], None, cr[i], None, wr[i])
         else:
             if tail_e[j]:
                 j, skipped_e = j + 1, skipped_e + 1
                 continue
-            mismatch_time = float(te[j])
-            reason = f"spurious run impact {j} at contact {ce[j]}, t={te[j]:.6g}"
+            mismatch = Mismatch("spurious", float(te[j]), None, j, None, te[j], None, ce[j], None)
         break
     p = np.array(pairs, dtype=int).reshape(-1, 2)
     errors = te[p[:, 1]] - tr[p[:, 0]]
-    return ImpactMatch(p, errors, mismatch_time, reason, n_r, skipped_r, skipped_e)
+    return ImpactMatch(
+        p,
+        errors,
+        None if mismatch is None else mismatch.t,
+        None if mismatch is None else mismatch_reason(mismatch),
+        n_r,
+        len(skipped_r),
+        skipped_e,
+        mismatch,
+        tuple(skipped_r),
+    )
+
+
+def mismatch_reason(m: Mismatch) -> str:
+    """The mismatch as one sentence (the `divergence_reason` of `compare`)."""
+    if m.kind == "contact":
+        return (
+            f"reference impact {m.ref_index}: contact {m.contact_ref} at t={m.t_ref:.6g}, "
+            f"run contact {m.contact_run} at t={m.t_run:.6g}"
+        )
+    if m.kind == "time":
+        return (
+            f"reference impact {m.ref_index} (contact {m.contact_ref}): t={m.t_ref:.6g}, run "
+            f"t={m.t_run:.6g}, |dt|={abs(m.time_offset):.3g} > window {m.window:.3g}"
+        )
+    if m.kind == "missed":
+        return f"reference impact {m.ref_index} (contact {m.contact_ref}, t={m.t_ref:.6g}) missed"
+    return f"spurious run impact {m.run_index} at contact {m.contact_run}, t={m.t_run:.6g}"
 
 
 def impacts_matched(run: Trajectory, reference: Trajectory, tolerance: MatchTolerance) -> int:

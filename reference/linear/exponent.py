@@ -1,20 +1,20 @@
-"""The energy exponent c of E ≈ a (t_f − t)^c (paper eq. scalinglaw, sections 3.4, 3.6, 4.3).
+"""The energy exponent c of E ≈ a (t_f − t)^c for the linear model (paper eq. scalinglaw,
+sections 3.4, 3.6, 4.3).
 
-Two estimators that share nothing but the data:
+c itself is the project's one estimator, reference.exponent (the regression of log E
+before each impact on log(t_f − t) inside its fit window, with its standard error);
+`exponent_of_run` feeds it a LinearRun, whose intervals and energies are kept as log2
+so that runs spanning hundreds of decades (gravity-free chatter with small c) keep
+their digits.  Two cross-checks that share nothing with it but the data:
 
-- `fit_energy_exponent`: the paper's regression of log E on log(t_f − t) over the
-  impacts; it needs the time of the singularity t_f (here: each impact's time-to-go,
-  the following intervals summed from the end plus the extrapolated remainder);
 - `exponent_from_decades`: from the time the run spends in successive decades of energy.
   If E = a (t_f − t)^c, the time spent while E falls from 10^(L+1) to 10^L is
   D_L ∝ 10^(L/c): log10 D_L is a line of slope 1/c in L, no t_f needed.
-  `exponent_from_period` is the same idea over one period P of a periodic impact
+- `exponent_from_period`: the same idea over one period P of a periodic impact
   pattern (E_i/E_(i+P) against the ratio of the durations of consecutive periods),
   exact for motion that repeats scaled.
 
 For self-similar motion (E_(i+1) = β² E_i, τ_(i+1) = β τ_i) every one of them gives 2.
-Runs can span hundreds of decades of time (gravity-free chatter with small c), so the
-run-level functions work with log2 of intervals and energies.
 """
 
 from __future__ import annotations
@@ -23,133 +23,19 @@ import math
 
 import numpy as np
 
-LOG2_10 = math.log2(10.0)
-
-
-def time_to_go(dt: np.ndarray, remainder: float = 0.0) -> np.ndarray:
-    """t_f − t_i for events i, where dt[i] is the interval before event i and
-    `remainder` the time from the last event to t_f: summed from the end (smallest
-    first), so every value keeps its relative precision however close to t_f."""
-    dt = np.asarray(dt, dtype=float)
-    out = np.empty(len(dt))
-    acc = float(remainder)
-    for i in range(len(dt) - 1, -1, -1):
-        out[i] = acc
-        acc += dt[i]
-    return out
-
-
-def _log2_sum(x: np.ndarray) -> float:
-    x = np.asarray(x, dtype=float)
-    x = x[np.isfinite(x)]
-    if len(x) == 0:
-        return -math.inf
-    return float(np.logaddexp2.reduce(x))
-
-
-def extrapolate_time_to_go(log2_dt, log2_energy, span: float = 1.0):
-    """log2 of the time from the last event to the singularity, assuming
-    E ∝ (t_f − t)^c over the last 2·`span` decades of energy.  With D1, D2 the durations
-    of the last two spans (energy drops ΔL1, ΔL2 decades), x = 1/c solves
-    D1/D2 = 10^(x ΔL2)(10^(x ΔL1) − 1)/(10^(x ΔL2) − 1), and the rest is
-    D2 / (10^(x ΔL2) − 1).  `log2_dt[i]` is log2 of the interval before event i,
-    `log2_energy[i]` log2 of the energy after it.  None if the run did not fall
-    2·span decades."""
-    ldt = np.asarray(log2_dt, dtype=float)
-    L = np.asarray(log2_energy, dtype=float) / LOG2_10
-    ok = np.isfinite(L)
-    if not ok.any():
-        return None
-    L_end = L[ok][-1]
-    n = len(L)
-    ia = np.flatnonzero(ok & (L <= L_end + 2 * span))
-    ib = np.flatnonzero(ok & (L <= L_end + span))
-    if len(ia) == 0 or len(ib) == 0 or L[0] < L_end + 2 * span:
-        return None
-    a, b = ia[0], ib[0]
-    if not (a < b < n - 1):
-        return None
-    lD1 = _log2_sum(ldt[a + 1 : b + 1])
-    lD2 = _log2_sum(ldt[b + 1 :])
-    dL1, dL2 = L[a] - L[b], L[b] - L_end
-    if not (math.isfinite(lD1) and math.isfinite(lD2) and dL1 > 0 and dL2 > 0):
-        return None
-    target = math.exp2(lD1 - lD2)
-    ln10 = math.log(10.0)
-
-    def ratio(x: float) -> float:
-        return 10 ** (x * dL2) * math.expm1(x * dL1 * ln10) / math.expm1(x * dL2 * ln10)
-
-    lo, hi = 1e-4, 30.0
-    if not (ratio(lo) <= target <= ratio(hi)):
-        return None
-    for _ in range(64):
-        mid = math.sqrt(lo * hi)
-        if ratio(mid) < target:
-            lo = mid
-        else:
-            hi = mid
-    x = math.sqrt(lo * hi)
-    return lD2 - math.log2(math.expm1(x * dL2 * ln10))
-
-
-def _ols(x: np.ndarray, y: np.ndarray):
-    xm, ym = x.mean(), y.mean()
-    sxx = float(np.sum((x - xm) ** 2))
-    c = float(np.sum((x - xm) * (y - ym)) / sxx)
-    b = float(ym - c * xm)
-    r = y - (b + c * x)
-    n = len(x)
-    rms = float(math.sqrt(np.sum(r * r) / n))
-    se = float(math.sqrt(np.sum(r * r) / max(n - 2, 1) / sxx))
-    return c, b, se, rms
-
-
-def fit_log_energy_exponent(log_ttg, log_energy) -> dict:
-    """`fit_energy_exponent` on natural logs of time-to-go and energy."""
-    x = np.asarray(log_ttg, dtype=float)
-    y = np.asarray(log_energy, dtype=float)
-    ok = np.isfinite(x) & np.isfinite(y)
-    x, y = x[ok], y[ok]
-    n = len(x)
-    out = {
-        "c": None,
-        "c_stderr": None,
-        "log_a": None,
-        "n_points": n,
-        "rms_residual": None,
-        "log10_energy_span": float(np.ptp(y) / math.log(10)) if n else 0.0,
-        "log10_time_span": float(np.ptp(x) / math.log(10)) if n else 0.0,
-        "c_spread": None,
-    }
-    if n < 3 or np.ptp(x) == 0:
-        return out
-    c, log_a, se, rms = _ols(x, y)
-    out.update(c=c, c_stderr=se, log_a=log_a, rms_residual=rms)
-    if n >= 8:
-        h = n // 2
-        c1 = _ols(x[:h], y[:h])[0]
-        c2 = _ols(x[h:], y[h:])[0]
-        out["c_spread"] = float(max(abs(c1 - c), abs(c2 - c)))
-    return out
-
-
-def fit_energy_exponent(time_to_go, energy) -> dict:
-    """Least-squares line log E = log a + c log(t_f − t) (the paper's regression).
-
-    Returns c, its standard error c_stderr (ordinary least squares; the residuals of a
-    staircase are correlated, so this understates the uncertainty: see c_spread), log_a
-    (natural log of a), the number of points, the rms residual, the decades spanned, and
-    c_spread: the larger difference between c and the slopes of the first and the
-    second half of the points."""
-    tt = np.asarray(time_to_go, dtype=float)
-    E = np.asarray(energy, dtype=float)
-    ok = (tt > 0) & (E > 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return fit_log_energy_exponent(
-            np.where(ok, np.log(np.where(ok, tt, 1.0)), np.nan),
-            np.where(ok, np.log(np.where(ok, E, 1.0)), np.nan),
-        )
+from ..exponent import (  # noqa: F401  (the one estimator; re-exported for the linear API)
+    LOG2_10,
+    MIN_DECADES,
+    SKIP_END,
+    SKIP_START,
+    _log2_sum,
+    extrapolate_time_to_go,
+    fit_energy_exponent,
+    fit_log_energy_exponent,
+    ordinary_least_squares,
+    regress_in_window,
+    time_to_go,
+)
 
 
 def exponent_from_decades(log2_dt, log2_energy, lo: float, hi: float) -> dict:
@@ -176,7 +62,7 @@ def exponent_from_decades(log2_dt, log2_energy, lo: float, hi: float) -> dict:
     # log10 D_L = const + L / c over the decades: slope 1/c by least squares
     x = levels[:-1][ok].astype(float)
     y = lD[ok] / LOG2_10
-    s, _, se, _ = _ols(x, y)
+    s, _, se, _ = ordinary_least_squares(x, y)
     if not s > 0:
         return {"c": None, "c_spread": None, "values": list(y)}
     return {"c": float(1.0 / s), "c_spread": float(se / s**2), "values": list(y)}
@@ -220,15 +106,18 @@ def exponent_from_period(log2_tau, log2_energy_pre, P: int, tail: int = 60) -> d
 
 
 def exponent_of_run(
-    run, skip_start: float = 3.0, skip_end: float = 2.0, min_decades: float = 6.0
+    run,
+    skip_start: float = SKIP_START,
+    skip_end: float = SKIP_END,
+    min_decades: float = MIN_DECADES,
 ) -> dict:
     """The estimators on a LinearRun that followed the energy down.
 
     Points are the impacts: the time-to-go at impact i (intervals summed from the end,
-    plus the extrapolated remainder) against the energy just before it.  The window
-    leaves out the first `skip_start` decades of energy (transient from the initial
-    state) and the last `skip_end` (where the remainder's error matters); c is None
-    unless the window spans `min_decades` decades."""
+    plus the extrapolated remainder) against the energy just before it; c, c_stderr,
+    c_spread and fit_decades come from reference.exponent.regress_in_window (the window
+    between the initial energy and the lowest energy after any event), c_decades and
+    c_period are the cross-checks of this module."""
     from . import kernel as K
 
     lE = run.log2_energy  # after each event
@@ -256,21 +145,22 @@ def exponent_of_run(
         return out
     lttg = K.log2_time_to_go(np.ascontiguousarray(run.log2_dt), float(lrem))
     lEpre = np.concatenate([[lE[0]], lE[:-1]])  # energy before event i
-    top = (lE[0] / LOG2_10) - skip_start
-    bottom = (lE[fin][-1] / LOG2_10) + skip_end
-    Lpre10 = lEpre / LOG2_10
-    sel = imp[(Lpre10[imp] <= top) & (Lpre10[imp] >= bottom)]
-    if len(sel) < 8 or top - bottom < min_decades:
-        return out
     ln2 = math.log(2.0)
-    fit = fit_log_energy_exponent(lttg[sel] * ln2, lEpre[sel] * ln2)
-    out.update(
-        c=fit["c"],
-        c_stderr=fit["c_stderr"],
-        log_a=fit["log_a"],
-        c_spread=fit["c_spread"],
-        fit_decades=float(top - bottom),
+    fit = regress_in_window(
+        lttg[imp] * ln2,
+        lEpre[imp] * ln2,
+        lE[0] / LOG2_10,
+        lE[fin][-1] / LOG2_10,
+        skip_start,
+        skip_end,
+        min_decades,
     )
+    out["fit_decades"] = fit["fit_decades"]
+    if fit["c"] is None:
+        return out
+    sel = imp[fit["selected"]]
+    out.update(c=fit["c"], c_stderr=fit["c_stderr"], log_a=fit["log_a"], c_spread=fit["c_spread"])
+    bottom, top = fit["window"]
     dec = exponent_from_decades(run.log2_dt, lE, bottom, top)
     out["c_decades"], out["c_decades_spread"] = dec["c"], dec["c_spread"]
     P = pattern_period(run.contact[sel], run.model.symmetry, tail=min(60, len(sel) - 2))

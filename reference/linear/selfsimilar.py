@@ -384,7 +384,7 @@ def format_selfsimilar(doc: dict) -> str:
         rows.append(
             [
                 f"{s['beta']:.9f}",
-                "trivial" if s["trivial"] else "",
+                "trivial" if s["trivial"] else "nontrivial",
                 "yes" if s["feasible"] else ("marginal" if s.get("marginal") else "no"),
                 "yes" if s["stable"] else "no",
                 f"{s['spectral_radius']:.6f}" if s["spectral_radius"] is not None else "-",

@@ -1,0 +1,297 @@
+"""`harness compare` for the terminal: a report that fits 100 columns (one verdict line per
+run and one sentence on who diverges first, when and why), or every column (`--wide`).
+docs/output.md defines each column."""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from typing import TYPE_CHECKING
+
+from reference.scene import Scene
+from reference.trajectory import Status
+
+from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
+from ..text import table
+
+if TYPE_CHECKING:
+    from . import CompareResult, EngineRun
+
+WIDTH = 100
+
+
+# ----------------------------------------------------------------------------- numbers
+
+
+def duration(x: float) -> str:
+    """A time interval with a unit a person reads at once: 1.2 s, 0.73 ms, 12 µs, 3.1 ns
+    (two significant digits, the unit in which the number is at least 0.1)."""
+    a = abs(x)
+    for scale, unit in ((1.0, "s"), (1e-3, "ms"), (1e-6, "µs"), (1e-9, "ns")):
+        if a >= 0.0995 * scale:  # 0.1 s less an ulp is still 0.1 s
+            return f"{x / scale:.2g} {unit}"
+    return f"{x:.2g} s"
+
+
+def seconds(x: float) -> str:
+    """A wall time: 0.4 ms, 0.041 s, 6.5 s, 13 s, 750 s."""
+    if x < 1e-3:
+        return f"{x * 1e3:.2g} ms"
+    return f"{x:.2g} s" if x < 10 else f"{x:.0f} s"
+
+
+def _num(x: float | None, fmt: str = ".1e") -> str:
+    return "-" if x is None or not math.isfinite(x) else format(x, fmt)
+
+
+def contact_name(scene: Scene, k: int | None) -> str:
+    """'v2' (vertex 2, flat ground) or 'b2' (bump 2, three_point ground)."""
+    if k is None:
+        return "?"
+    return f"{'v' if scene.ground.kind == 'flat' else 'b'}{int(k)}"
+
+
+def impacts_cell(m) -> str:
+    """'22/59' (matched of the reference's), '35+86/302' when 86 chatter-tail bounces of
+    the reference were skipped on the way (not compared one by one)."""
+    skipped = f"+{m.skipped_reference}" if m.skipped_reference else ""
+    return f"{m.impacts_matched}{skipped}/{m.reference_impacts}"
+
+
+def _exponent_cell(fit) -> str:
+    if fit is None or fit.c is None:
+        return "-"
+    return f"{fit.c:.2f}±{fit.c_stderr:.1g}"
+
+
+# ----------------------------------------------------------------------------- why
+
+
+def divergence_short(run: EngineRun, scene: Scene) -> str:
+    """Why a run left the reference, in at most ~30 characters."""
+    m = run.metrics
+    if run.trajectory.status is Status.FAILED:
+        return "failed (message below)"
+    if m.first_divergence_time is None:
+        return "no common time window" if m.common_window is None else "none"
+    if m.divergence_kind == "attitude":
+        return f"attitude off > {m.attitude_threshold:.1g} rad"
+    x = m.first_mismatch
+    c_ref, c_run = contact_name(scene, x.contact_ref), contact_name(scene, x.contact_run)
+    if x.kind == "time":
+        late = "late" if x.time_offset > 0 else "early"
+        return f"impact {x.ref_index} ({c_ref}) {duration(abs(x.time_offset))} {late}"
+    if x.kind == "contact":
+        return f"impact {x.ref_index}: {c_run} hit, not {c_ref}"
+    if x.kind == "missed":
+        return f"impact {x.ref_index} ({c_ref}) missed"
+    return f"extra impact at {c_run}"
+
+
+def divergence_sentence(run: EngineRun, scene: Scene) -> str:
+    """Why a run left the reference, as a sentence with the numbers."""
+    m = run.metrics
+    if m.first_divergence_time is None:
+        return "it does not diverge"
+    if m.divergence_kind == "attitude":
+        return (
+            f"its attitude is more than {m.attitude_threshold:.2g} rad (a tenth of the "
+            "reference's largest tilt) away from the reference's"
+        )
+    x = m.first_mismatch
+    c_ref, c_run = contact_name(scene, x.contact_ref), contact_name(scene, x.contact_run)
+    if x.kind == "time":
+        late = "after" if x.time_offset > 0 else "before"
+        return (
+            f"its impact at {c_ref} came {duration(abs(x.time_offset))} {late} the "
+            f"reference's impact {x.ref_index} (t = {x.t_ref:.7g} s), outside the "
+            f"±{duration(x.window)} window"
+        )
+    if x.kind == "contact":
+        return (
+            f"at the reference's impact {x.ref_index} (t = {x.t_ref:.7g} s, {c_ref}) it hit "
+            f"{c_run} instead (t = {x.t_run:.7g} s)"
+        )
+    if x.kind == "missed":
+        return (
+            f"it has no impact where the reference's impact {x.ref_index} hits {c_ref} "
+            f"(t = {x.t_ref:.7g} s)"
+        )
+    return f"it hits {c_run} at t = {x.t_run:.7g} s, where the reference has no impact"
+
+
+def verdict_line(run: EngineRun, scene: Scene) -> str:
+    """One line per run for JSON readers: matched k/N, divergence, energy error, cost."""
+    m = run.metrics
+    when = (
+        "follows the reference throughout"
+        if m.first_divergence_time is None
+        else f"diverges at t = {m.first_divergence_time:.6g} s: {divergence_sentence(run, scene)}"
+    )
+    e = m.energy_error_agreeing
+    return (
+        f"{run.label}: {m.impacts_matched}/{m.reference_impacts} impacts matched; {when}; "
+        f"energy error {_num(e, '.2e')} while following; {seconds(run.wall_time_s)}"
+    )
+
+
+# ----------------------------------------------------------------------------- report
+
+
+def _header(result: CompareResult) -> list[str]:
+    scene, ref = result.scene, result.reference
+    body = scene.body
+    shape = "rod" if body.n == 2 else f"{body.n}-gon"
+    head = (
+        f"{scene.name}: {shape} on {scene.ground.kind.replace('_', '-')} ground, "
+        f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}"
+    )
+    text = (
+        f"reference: {ref.status.value} at t = {ref.t_final:.7g} s after {len(ref.impacts)} "
+        f"impacts ({seconds(result.reference_wall_time_s)})"
+    )
+    if ref.message and ref.status is not Status.T_END:
+        text += f": {ref.message}"
+    fit = result.reference_exponent
+    if fit is not None and fit.c is not None:
+        text += f"; energy exponent {fit.describe()}"
+    return [head, *textwrap.wrap(text, WIDTH, subsequent_indent="  ")]
+
+
+def _verdict_table(result: CompareResult) -> str:
+    rows = []
+    for run in result.runs:
+        m = run.metrics
+        t_div = m.first_divergence_time
+        rows.append(
+            [
+                run.label,
+                impacts_cell(m),
+                "-" if t_div is None else f"{t_div:.5g} s",
+                divergence_short(run, result.scene),
+                _num(m.energy_error_agreeing),
+                _exponent_cell(run.exponent),
+                seconds(run.wall_time_s),
+            ]
+        )
+    header = ["simulator", "impacts", "diverges", "why", "E err", "c", "cost"]
+    return table(rows, header, align="lrrlrrr")
+
+
+def _first_to_diverge(result: CompareResult) -> list[str]:
+    first = result.first_to_diverge()
+    if first is None:
+        return ["No simulator diverges from the reference inside its time window."]
+    t = first.metrics.first_divergence_time
+    text = (
+        f"First to diverge: {first.label} at t = {t:.6g} s: "
+        f"{divergence_sentence(first, result.scene)}."
+    )
+    return textwrap.wrap(text, WIDTH, subsequent_indent="  ")
+
+
+LEGEND = (
+    "impacts: k/N leading reference impacts the run reproduces (same contact, time within "
+    f"{STEPS_TIME_TOLERANCE:g}·dt + {RELATIVE_TIME_TOLERANCE:g}·t); k+s/N: s slow chatter-tail "
+    "bounces skipped on the way. diverges: first impact "
+    "that disagrees, or attitude off by a tenth of the largest tilt. E err: "
+    "max|E−E_ref|/E_ref(0) while the run follows the reference. c: energy exponent ± its "
+    "standard error, "
+    "only for runs that reach the singularity. cost: wall time. v2 = vertex 2, b2 = bump 2. "
+    "Every column: --wide; definitions: docs/output.md."
+)
+
+
+def _failures(result: CompareResult) -> list[str]:
+    lines = []
+    for run in result.runs:
+        if run.trajectory.status is Status.FAILED and run.trajectory.message:
+            lines += textwrap.wrap(
+                f"{run.label} failed: {run.trajectory.message}", WIDTH, subsequent_indent="  "
+            )
+    return lines
+
+
+def format_compare(result: CompareResult, wide: bool = False) -> str:
+    """The report: scene and reference, one verdict row per run, who diverges first and
+    why, a short legend.  `wide`: every column instead (wider than 100 characters)."""
+    if wide:
+        return format_compare_wide(result)
+    lines = [*_header(result), "", _verdict_table(result), ""]
+    lines += _first_to_diverge(result)
+    lines += _failures(result)
+    lines += ["", *textwrap.wrap(LEGEND, WIDTH)]
+    return "\n".join(lines)
+
+
+def format_compare_wide(result: CompareResult) -> str:
+    """Every column of every run, and every rule behind them."""
+    header = [
+        "engine",
+        "dt",
+        "status",
+        "wall[s]",
+        "impacts",
+        "matched",
+        "tails",
+        "t_err[s]",
+        "E_err",
+        "E_err<div",
+        "att_err[rad]",
+        "att<div",
+        "diverge[s]",
+        "why",
+        "e_eff",
+        "c",
+        "t_f from",
+    ]
+    rows = []
+    for run in result.runs:
+        m = run.metrics
+        r = m.restitution
+        fit = run.exponent
+        rows.append(
+            [
+                run.engine,
+                "-" if run.dt is None else f"{run.dt:g}",
+                run.trajectory.status.value,
+                f"{run.wall_time_s:.2f}",
+                str(m.impacts),
+                f"{m.impacts_matched}/{m.reference_impacts}",
+                f"{m.skipped_reference}/{m.skipped_run}",
+                _num(m.impact_time_error, ".2e"),
+                _num(m.energy_error, ".2e"),
+                _num(m.energy_error_agreeing, ".2e"),
+                _num(m.attitude_error, ".2e"),
+                _num(m.attitude_error_agreeing, ".2e"),
+                _num(m.first_divergence_time, ".6g"),
+                divergence_short(run, result.scene),
+                "-" if r.median is None else f"{r.median:.4f} (n={r.n})",
+                _exponent_cell(fit),
+                fit.t_f_source or "-",
+            ]
+        )
+    lines = [*_header(result), "", table(rows, header, align="lrlrrrrrrrrrrlrrl"), ""]
+    lines += [
+        "matched: leading impacts with the reference's contact and time, |dt| <= "
+        f"{STEPS_TIME_TOLERANCE:g} steps (1e-9 s event-driven) + {RELATIVE_TIME_TOLERANCE:g}*t, "
+        "capped at half the gap to the next same-contact reference impact; of the reference "
+        "impacts in the common window",
+        "tails: chatter-tail impacts skipped (reference/run): approach slower than "
+        "max(10 g dt, 1% of the fastest), at a contact already in the chatter episode",
+        "E_err: max |E - E_ref|/E_ref(0) away from impacts; att_err: max attitude angle; "
+        "<div: the same before the first divergence",
+        "diverge: first impact mismatch or attitude error > 0.1 x max reference tilt; "
+        "e_eff: median -v_post/v_pre of the run's impacts approaching faster than "
+        "max(10 g dt, 1% of the fastest)",
+        "c: energy exponent of E ~ a (t_f - t)^c ± standard error (reference.exponent), only "
+        "for runs that reach the singularity; t_f from: where t_f came from",
+    ]
+    for run in result.runs:
+        m = run.metrics
+        if m.divergence_reason:
+            lines.append(f"  {run.label}: {m.divergence_reason}")
+        if run.exponent.c is None and run.exponent.reason:
+            lines.append(f"  {run.label}: no c: {run.exponent.reason}")
+    lines += _failures(result)
+    return "\n".join(lines)
