@@ -25,7 +25,7 @@ from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
 from ..metrics import RunMetrics, effective_restitution, evaluate, run_exponent
-from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator
+from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator, warm_up
 
 
 @dataclass
@@ -114,7 +114,8 @@ def compare(
 ) -> CompareResult:
     """Run the reference once and each engine at each dt (DEFAULT_DT when `dts` is None;
     once for `reference` and `linear`), all to the same t_end, and score every run.
-    `progress` gets one line per run with its wall time (for stderr)."""
+    Each simulator is warmed up before it is timed.  `progress` gets one line per run
+    with its wall time (for stderr)."""
     say = progress or (lambda _msg: None)
     dts = list(dts) if dts else [DEFAULT_DT]
     reference, ref_wall = _timed_run("reference", scene, None, t_end, reraise=True)
@@ -136,6 +137,9 @@ def compare(
 def _timed_run(
     engine: str, scene: Scene, dt: float | None, t_end: float | None, reraise: bool = False
 ) -> tuple[Trajectory, float]:
+    """The run and its wall time, after a warm-up (simulators.warm_up) so that the time
+    is the simulation's, not one-time imports or compilation."""
+    warm_up(engine, scene, dt)
     start = time.perf_counter()
     try:
         traj = run_simulator(engine, scene, dt=dt, t_end=t_end)
