@@ -406,8 +406,19 @@ def _cost_ratio(t: float, err: float, ref_front: list[tuple[float, float]]) -> d
 
 
 def plot_work_precision(doc: dict[str, Any], path: str | os.PathLike) -> str:
-    """Log-log PNG: one panel per error metric, error against median wall time, one
-    curve per simulator, points labelled with their setting."""
+    """The work-precision figure (`work_precision_figure`) as a PNG file."""
+    import matplotlib.pyplot as plt
+
+    fig = work_precision_figure(doc)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return str(path)
+
+
+def work_precision_figure(doc: dict[str, Any]):
+    """Log-log: one panel per error metric, error against median wall time, one curve
+    per simulator, points labelled with their setting; drawn from the bench document's
+    rows alone (so `harness report` can redraw it)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -450,9 +461,7 @@ def plot_work_precision(doc: dict[str, Any], path: str | os.PathLike) -> str:
         fontsize=9,
     )
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return str(path)
+    return fig
 
 
 def _fmt(x: float | None, spec: str = ".2e") -> str:

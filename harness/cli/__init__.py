@@ -18,10 +18,34 @@ import traceback
 
 from reference.scene import SceneError
 
-from . import analyze, bench, compare, engines, figures, scenes, simulate, stress, sweep
+from . import (
+    analyze,
+    bench,
+    compare,
+    engines,
+    fidelity,
+    figures,
+    report,
+    scenes,
+    simulate,
+    stress,
+    sweep,
+)
 from .common import BadInput, Parser, add_verbose, configure_logging
 
-COMMANDS = (scenes, engines, simulate, compare, bench, stress, analyze, sweep, figures)
+COMMANDS = (
+    scenes,
+    engines,
+    simulate,
+    compare,
+    bench,
+    stress,
+    fidelity,
+    analyze,
+    sweep,
+    figures,
+    report,
+)
 
 
 def build_parser() -> Parser:
@@ -47,7 +71,9 @@ def _subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser
 
 def main(argv: list[str] | None = None) -> int:
     try:
+        argv = list(sys.argv[1:] if argv is None else argv)
         args = build_parser().parse_args(argv)
+        args.argv = argv  # the exact command, for the results' provenance
         configure_logging(args.verbose)
         return args.func(args)
     except (BadInput, SceneError) as exc:

@@ -24,6 +24,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..bench import bench, format_bench
+    from ..provenance import attach
 
     scene = load_scene_arg(args)
     doc = bench(
@@ -36,6 +37,7 @@ def run(args) -> int:
         progress=log,
         budget_s=args.budget,
     )
+    attach(doc, args)
     if args.out:
         Path(args.out).write_text(json.dumps(finite(doc), indent=1))
     emit(doc, args.json, format_bench(doc))

@@ -9,7 +9,7 @@ import math
 import sys
 from typing import Any
 
-LOGGERS = ("harness", "engines", "reference")  # ours: INFO with -v/--verbose
+from ..progress import LOGGERS  # ours: INFO with -v/--verbose
 
 
 class BadInput(Exception):

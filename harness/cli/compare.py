@@ -30,6 +30,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..compare import compare, format_compare
+    from ..provenance import attach
     from ..simulators import check_engine
 
     for e in args.engine:
@@ -43,11 +44,12 @@ def run(args) -> int:
             raise BadInput(str(exc)) from None
     scene = load_scene_arg(args)
     result = compare(scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log)
+    recording = None
     if args.record:
         from ..recording import record_comparison
 
-        path = record_comparison(result, args.record, note=note)
-        note(f"wrote {path}")
+        recording = record_comparison(result, args.record, note=note)
+        note(f"wrote {recording}")
     if args.out:
         from ..compare.diff import impact_diff
         from ..io import write_table
@@ -57,5 +59,8 @@ def run(args) -> int:
         except ValueError as exc:
             raise BadInput(str(exc)) from None
         note(f"wrote {path}")
-    emit(result.to_dict(), args.json, format_compare(result, wide=args.wide))
+    doc = result.to_dict()
+    if recording is not None:
+        doc["recording"] = str(recording)
+    emit(attach(doc, args), args.json, format_compare(result, wide=args.wide))
     return 0

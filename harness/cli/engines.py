@@ -22,6 +22,7 @@ def engine_rows() -> list[dict]:
     distribution that registers it), fixed_step and library (the optional `library`
     attribute: the physics engine's distribution) with its version (None when it does not
     load), and the load error (None when it loads)."""
+    from ..provenance import distribution_version
     from ..simulators import EngineLoadError, engine_infos, is_fixed_step, load_engine
 
     rows = []
@@ -39,23 +40,11 @@ def engine_rows() -> list[dict]:
         try:
             row["fixed_step"] = is_fixed_step(info.name)
             row["library"] = getattr(load_engine(info.name), "library", None)
-            row["library_version"] = _version(row["library"])
+            row["library_version"] = distribution_version(row["library"])
         except EngineLoadError as exc:
             row["error"] = str(exc)
         rows.append(row)
     return rows
-
-
-def _version(distribution: str | None) -> str | None:
-    """Installed version of a distribution, from its metadata (nothing imported)."""
-    from importlib import metadata
-
-    if distribution is None:
-        return None
-    try:
-        return metadata.version(distribution)
-    except metadata.PackageNotFoundError:
-        return "not installed"
 
 
 def run(args) -> int:

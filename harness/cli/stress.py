@@ -16,10 +16,11 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..provenance import attach
     from ..stress import format_stress, stress
 
     doc = stress(
         engines=args.engine, cases=args.case, dt=args.dt, progress=log, budget_s=args.budget
     )
-    emit(doc, args.json, format_stress(doc))
+    emit(attach(doc, args), args.json, format_stress(doc))
     return 0

@@ -29,8 +29,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from ..provenance import attach
     from ..sweep import run_exponent_sweep
 
-    doc = run_exponent_sweep(args, progress=log)
+    doc = attach(run_exponent_sweep(args, progress=log), args)
     emit(doc, args.json, doc.get("text", json.dumps(finite(doc), indent=1)))
     return 0

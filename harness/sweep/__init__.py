@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -119,8 +118,7 @@ def exponent_sweep(
     """Run (or resume) a sweep into the study directory `out` and summarise it.
 
     `run_fn` replaces run.run_chunk (tests); `figures=False` skips the PNGs."""
-    from tqdm import tqdm
-
+    from ..progress import progress_bar
     from . import executors as sweep_exec
     from .run import run_chunk
 
@@ -151,19 +149,13 @@ def exponent_sweep(
 
                 warm_up(config)
             results = sweep_exec.run_local(chunks, workers=workers, fn=run_fn)
-        tqdm.monitor_interval = 0  # no monitor thread (the local pool forks)
-        pbar = tqdm(
-            total=config.n_tasks,
-            initial=len(done),
-            unit="run",
-            file=sys.stderr,
-            disable=not bar or not missing,
-            mininterval=0.5 if sys.stderr.isatty() else 10.0,
-            smoothing=0.05,
-            dynamic_ncols=True,
-        )
         t_compute = time.perf_counter()
-        with pbar:
+        with progress_bar(
+            config.n_tasks,
+            f"sweep {config.engine}",
+            show=bar and bool(missing),
+            initial=len(done),
+        ) as pbar:
             for chunk, rows in results:
                 store.write_part(rows, chunk.label)
                 for r in rows:

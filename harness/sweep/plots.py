@@ -154,6 +154,24 @@ def plot_sections(axes, df_by_engine: dict, configs: dict, n: int, colors=None):
         ax.set_visible(False)
 
 
+def sweep_label(config: SweepConfig) -> str:
+    """'linear, n = 3, 100 runs per point, seed 0' (the figures' subtitle)."""
+    return f"{config.engine}, n = {config.n}, {config.samples} runs per point, seed {config.seed}"
+
+
+def exponent_map_figure(
+    stats: pd.DataFrame, config: SweepConfig, bounds: Boundaries | None, label: str
+):
+    """The exponent map (mean c per grid point, CC/PCC boundaries) as a figure, from
+    the per-point statistics alone (`grid_stats`), so `harness report` can redraw it
+    from a sweep's JSON summary."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 6.5), layout="constrained")
+    mesh = plot_exponent_map(ax, stats, config, bounds, f"mean energy exponent c ({label})")
+    fig.colorbar(mesh, ax=ax, label="mean c (grey: no run with a c)")
+    return fig
+
+
 def make_sweep_figures(
     sweep_dir: Path, df: pd.DataFrame, config: SweepConfig, boundary_points: int = 61
 ) -> dict:
@@ -162,12 +180,10 @@ def make_sweep_figures(
     sweep_dir = Path(sweep_dir)
     stats = grid_stats(df, config)
     bounds = Boundaries(config, boundary_points)
-    label = f"{config.engine}, n = {config.n}, {config.samples} runs per point, seed {config.seed}"
+    label = sweep_label(config)
     paths = {}
 
-    fig, ax = plt.subplots(figsize=(8, 6.5), layout="constrained")
-    mesh = plot_exponent_map(ax, stats, config, bounds, f"mean energy exponent c ({label})")
-    fig.colorbar(mesh, ax=ax, label="mean c (grey: no run with a c)")
+    fig = exponent_map_figure(stats, config, bounds, label)
     paths["exponent_map"] = str(sweep_dir / "exponent-map.png")
     fig.savefig(paths["exponent_map"], dpi=130)
     plt.close(fig)

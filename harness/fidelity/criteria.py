@@ -1,0 +1,134 @@
+"""When a run is faithful, the fidelity limit α* of an engine, and its power law in dt.
+
+- A run **passes** at one scale when it matches at least `match_fraction` (default
+  90 %) of the reference's leading impacts (leading.py; matched = same contact and time
+  within the window of harness.metrics.match_impacts, in order), and, where the
+  reference and the run both have an energy exponent c (harness.metrics.run_exponent:
+  only runs that reach the end of the motion), |c − c_ref| ≤ `c_tolerance`·|c_ref|
+  (default 10 %).  Where either has no c the run is judged on its impacts alone and the
+  row says why (`c_check`).
+- **α*** of an engine at one dt: walking the ε grid from the largest inclination down,
+  the smallest α at which the engine passes before its first failure.  Runs skipped for
+  the budget do not interrupt the walk (they are counted).  `bound` says what the grid
+  tells: "bracket" (it passes at α* and fails at the next α of the grid,
+  `alpha_first_fail`), "at most" (it passes at every α run: α* ≤ the smallest), "above
+  grid" (it fails at the largest α run: α* > it, value null) or "not measured".  Passes
+  below the first failure are listed (`passes_below`): they are luck, not fidelity.
+- **k** of α* ∝ dt^k: ordinary least squares of log10 α* on log10 dt over the dts
+  whose α* is a "bracket" value, with the slope's standard error
+  (reference.exponent.ordinary_least_squares); no standard error with fewer than 3
+  points, no k with fewer than 2.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from reference.exponent import ordinary_least_squares
+
+DEFAULT_LEADING = 10
+DEFAULT_MATCH_FRACTION = 0.9
+DEFAULT_C_TOLERANCE = 0.1
+
+
+@dataclass(frozen=True)
+class FidelityCriteria:
+    """The thresholds of the test (module docstring), stated in every output."""
+
+    leading: int = DEFAULT_LEADING
+    match_fraction: float = DEFAULT_MATCH_FRACTION
+    c_tolerance: float = DEFAULT_C_TOLERANCE
+
+    def describe(self) -> str:
+        return (
+            f"a run passes when it matches >= {self.match_fraction:.0%} of the reference's "
+            f"first {self.leading} leading impacts (chatter tails left out) and, where the "
+            f"reference and the run both have an energy exponent c, |c - c_ref| <= "
+            f"{self.c_tolerance:.0%} of c_ref; alpha* is the smallest inclination at which "
+            "it passes, every larger one it ran passing too"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**asdict(self), "rule": self.describe()}
+
+
+def impacts_pass(matched: int, leading: int, criteria: FidelityCriteria) -> bool:
+    """matched / leading ≥ match_fraction (with leading ≥ 1)."""
+    return leading > 0 and matched >= criteria.match_fraction * leading - 1e-9
+
+
+def exponent_check(
+    c_run: float | None,
+    c_ref: float | None,
+    criteria: FidelityCriteria,
+    run_reason: str = "",
+    ref_reason: str = "",
+) -> tuple[bool | None, str]:
+    """(verdict, explanation) of the exponent criterion: True / False when both runs
+    have a c, None (not compared) otherwise, with the reason."""
+    if c_ref is None:
+        return None, f"not compared: the reference has no c ({ref_reason or 'no reason given'})"
+    if c_run is None:
+        return None, f"not compared: the run has no c ({run_reason or 'no reason given'})"
+    rel = abs(c_run - c_ref) / abs(c_ref)
+    ok = rel <= criteria.c_tolerance
+    return ok, f"|c - c_ref| / c_ref = {rel:.3g} {'<=' if ok else '>'} {criteria.c_tolerance:g}"
+
+
+def alpha_star(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """α* of one engine at one dt from its rows (module docstring).  Each row has
+    `alpha`, `eps`, `passes` (True / False, None when not run) and `skipped` (None or
+    the reason)."""
+    ordered = sorted(rows, key=lambda r: -r["alpha"])
+    star: dict[str, Any] | None = None
+    first_fail: dict[str, Any] | None = None
+    skipped = 0
+    for row in ordered:
+        if row.get("skipped") or row.get("passes") is None:
+            skipped += bool(row.get("skipped"))
+            continue
+        if row["passes"]:
+            star = row
+            continue
+        first_fail = row
+        break
+    ran = [r for r in ordered if r.get("passes") is not None]
+    below = [] if first_fail is None else [r for r in ran if r["alpha"] < first_fail["alpha"]]
+    out = {
+        "alpha_star": star["alpha"] if star else None,
+        "eps_star": star["eps"] if star else None,
+        "alpha_first_fail": first_fail["alpha"] if first_fail else None,
+        "bound": _bound(star, first_fail, ran),
+        "runs": len(ran),
+        "passes": sum(1 for r in ran if r["passes"]),
+        "skipped": skipped,
+        "passes_below": [r["alpha"] for r in below if r["passes"]],
+    }
+    return out
+
+
+def _bound(star, first_fail, ran) -> str:
+    if not ran:
+        return "not measured"
+    if star is None:
+        return "above grid"
+    return "at most" if first_fail is None else "bracket"
+
+
+def power_law_fit(dts: Sequence[float], alphas: Sequence[float]) -> dict[str, Any]:
+    """k, its standard error and log10 A of α* = A dt^k (least squares in log-log)."""
+    x = np.log10(np.asarray(dts, dtype=float))
+    y = np.log10(np.asarray(alphas, dtype=float))
+    n = len(x)
+    out: dict[str, Any] = {"k": None, "k_stderr": None, "log10_A": None, "n_points": n}
+    if n < 2 or np.ptp(x) == 0:
+        return out
+    k, b, se, rms = ordinary_least_squares(x, y)
+    out.update(k=k, log10_A=b, rms_residual_decades=rms)
+    out["k_stderr"] = se if n >= 3 and math.isfinite(se) else None
+    return out

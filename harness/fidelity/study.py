@@ -1,0 +1,404 @@
+"""Running the fidelity study: the reference and every engine over the ε grid and dts.
+
+For each ε: the scene scaled by the paper's invariance (Scene.scaled: q → ε²q, p → εp)
+with its t_end scaled too (t → εt: the motion's time scale is ε), and the reference run
+on it (exact at every scale: scaled impact times agree to 1e-12 and better, README).
+For each engine and dt, the scales are run from the smallest ε up (the cheapest first),
+each to `leading.run_end`, and scored against that scale's reference
+(harness.metrics.evaluate, the leading impacts, the exponent).
+
+Budget (the rules of `harness stress` and `harness bench`, by calling their functions):
+each fixed-step run's wall time is predicted (`predict_run_time`: pilot runs for long
+ones, and an extrapolation from the same engine and dt at the smaller scales already
+run) and the run is skipped when the prediction exceeds the per-run budget; a run of
+more than PILOT_FREE_STEPS steps runs in a forked child stopped at HARD_CAP_FACTOR × the
+budget (predictions can miss costly later phases).  Once a scale is skipped or
+stopped, the larger scales of that engine and dt are skipped too: they cover the same
+motion with more steps.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from reference.exponent import ExponentFit
+from reference.scene import Scene, SceneError
+from reference.trajectory import Trajectory
+
+from ..bench import predict_time
+from ..metrics import evaluate
+from ..progress import progress_bar
+from ..simulators import engine_names, is_fixed_step, run_simulator, warm_up
+from ..stress.budget import (
+    HARD_CAP_FACTOR,
+    PILOT_FREE_STEPS,
+    over_budget,
+    predict_engine_time,
+    run_capped,
+    timed,
+)
+from .criteria import FidelityCriteria, alpha_star, exponent_check, impacts_pass, power_law_fit
+from .exponent import exponent_of
+from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
+
+DEFAULT_DTS = (1e-3, 1e-4, 1e-5)
+DEFAULT_EPS_GRID = (1.0, 1e-4, 17)  # first, last, count: log-spaced, α half a decade apart
+DEFAULT_BUDGET_S = 60.0  # per run
+WINDOWS = ("leading", "scene")
+NOT_ENGINES = ("reference", "linear")  # the default engines are every other one
+MESSAGE_CHARS = 300
+
+
+def eps_values(first: float, last: float, count: int) -> list[float]:
+    """`count` values of ε from `first` to `last`, evenly spaced in log ε, largest first."""
+    if not (first > 0 and last > 0) or count < 1:
+        raise SceneError(f"--eps-grid needs A:B:K with A, B > 0 and K >= 1, got {first}:{last}")
+    return sorted((float(x) for x in np.geomspace(first, last, count)), reverse=True)
+
+
+def default_engines() -> list[str]:
+    """Every installed engine but the reference and the linear model."""
+    return [e for e in engine_names() if e not in NOT_ENGINES]
+
+
+# ----------------------------------------------------------------------------- scales
+
+
+@dataclass(frozen=True)
+class ScaleCase:
+    """The reference at one scale ε: the scaled scene, its run and what it defines."""
+
+    eps: float
+    scene: Scene
+    reference: Trajectory
+    wall_time_s: float
+    leading: LeadingImpacts
+    alpha: float
+    alpha0: float
+    exponent: ExponentFit
+
+    def to_dict(self, first: ScaleCase | None = None) -> dict[str, Any]:
+        ref = self.reference
+        doc = {
+            "eps": self.eps,
+            "alpha": self.alpha,
+            "alpha0": self.alpha0,
+            "t_end": self.scene.run.t_end,
+            "status": ref.status.value,
+            "impacts": len(ref.impacts),
+            "t_final": ref.t_final,
+            "t_final_scaled": ref.t_final / self.eps,
+            "leading": self.leading.n,
+            "leading_t_last_scaled": None
+            if self.leading.t_last is None
+            else self.leading.t_last / self.eps,
+            "wall_time_s": self.wall_time_s,
+            "c": self.exponent.c,
+            "c_stderr": self.exponent.c_stderr,
+            "c_reason": self.exponent.reason or None,
+        }
+        doc.update(self._same_motion(first))
+        return doc
+
+    def _same_motion(self, first: ScaleCase | None) -> dict[str, Any]:
+        """Whether the leading impacts are those of the first scale's (same contacts in
+        the same order), and the largest shift of their scaled times (t/ε): the check
+        that every scale tests the same motion (it differs by O(α))."""
+        if first is None or first.leading.n != self.leading.n or self.leading.n == 0:
+            return {"same_contacts_as_first": None, "scaled_time_shift": None}
+        a, b = self.reference, first.reference
+        ia, ib = self.leading.indices, first.leading.indices
+        same = bool(np.array_equal(a.impact_contacts()[ia], b.impact_contacts()[ib]))
+        shift = np.abs(a.impact_times()[ia] / self.eps - b.impact_times()[ib] / first.eps)
+        return {"same_contacts_as_first": same, "scaled_time_shift": float(shift.max())}
+
+
+def scale_case(scene: Scene, eps: float, criteria: FidelityCriteria) -> ScaleCase:
+    """Scale the scene by ε (t_end by ε too) and run the reference on it."""
+    scaled = scene.scaled(eps)
+    scaled = scaled.with_run(t_end=eps * scene.run.t_end)
+    start = time.perf_counter()
+    ref = run_simulator("reference", scaled, t_end=scaled.run.t_end)
+    wall = time.perf_counter() - start
+    if ref.n_samples == 0 or ref.status.value == "failed":
+        raise RuntimeError(f"the reference failed on {scene.name} at eps={eps:g}: {ref.message}")
+    lead = leading_impacts(ref, criteria.leading, scaled.gravity)
+    alpha0 = float(ref.inclination[0])
+    return ScaleCase(
+        eps,
+        scaled,
+        ref,
+        wall,
+        lead,
+        inclination_scale(ref, lead.t_last),
+        alpha0,
+        exponent_of(ref, scaled),
+    )
+
+
+# ----------------------------------------------------------------------------- one run
+
+
+def score(traj: Trajectory, case: ScaleCase, criteria: FidelityCriteria) -> dict[str, Any]:
+    """The metrics of one engine run at one scale and its verdict."""
+    m = evaluate(traj, case.reference, case.scene.gravity)
+    pairs = m.match.pairs if m.match is not None else np.zeros((0, 2), int)
+    in_leading = np.isin(pairs[:, 0], case.leading.indices)
+    matched = int(in_leading.sum())
+    t_err = float(np.max(np.abs(m.match.time_errors[in_leading]))) if matched else None
+    fit = exponent_of(traj, case.scene, case.reference, m.match)
+    ref_fit = case.exponent
+    c_ok, c_why = exponent_check(fit.c, ref_fit.c, criteria, fit.reason, ref_fit.reason)
+    impacts_ok = impacts_pass(matched, case.leading.n, criteria)
+    return {
+        "status": traj.status.value,
+        "message": (traj.message or "")[:MESSAGE_CHARS] or None,
+        "impacts": len(traj.impacts),
+        "leading_matched": matched,
+        "match_fraction": matched / case.leading.n if case.leading.n else None,
+        "first_mismatch": m.divergence_reason if m.divergence_kind != "attitude" else None,
+        "first_divergence_time_scaled": None
+        if m.first_divergence_time is None
+        else m.first_divergence_time / case.eps,
+        "impact_time_error_s": t_err,
+        "impact_time_error_scaled": None if t_err is None else t_err / case.eps,
+        "energy_error": m.energy_error_agreeing,
+        "energy_error_window": m.energy_error,
+        "c": fit.c,
+        "c_stderr": fit.c_stderr,
+        "c_reason": fit.reason or None,
+        "c_reference": ref_fit.c,
+        "c_relative_error": None
+        if fit.c is None or ref_fit.c is None
+        else abs(fit.c - ref_fit.c) / abs(ref_fit.c),
+        "c_check": c_why,
+        "criterion": "impacts and c" if c_ok is not None else "impacts only",
+        "impacts_pass": impacts_ok,
+        "passes": bool(impacts_ok and c_ok is not False),
+    }
+
+
+def _base_row(engine: str, dt: float | None, case: ScaleCase, t_run: float) -> dict[str, Any]:
+    return {
+        "engine": engine,
+        "dt": dt,
+        "eps": case.eps,
+        "alpha": case.alpha,
+        "alpha0": case.alpha0,
+        "t_end": t_run,
+        "t_end_scaled": t_run / case.eps,
+        "steps": None if dt is None else int(math.ceil(t_run / dt - 1e-9)),
+        "leading": case.leading.n,
+        "passes": None,
+        "skipped": None,
+        "predicted_wall_time_s": None,
+        "wall_time_s": None,
+    }
+
+
+def engine_row(
+    engine: str,
+    dt: float | None,
+    case: ScaleCase,
+    criteria: FidelityCriteria,
+    window: str,
+    budget_s: float,
+    measured: Sequence[tuple[float, float]] = (),
+    blocked: str | None = None,
+) -> dict[str, Any]:
+    """Run one engine at one scale within the budget (module docstring) and score it.
+    `measured`: (steps, wall time) of this engine and dt at the smaller scales already
+    run; `blocked`: the reason a smaller scale of this engine and dt was not run (this
+    one, costlier, is skipped with it)."""
+    t_run = run_end(case.leading, case.scene.run.t_end, dt, window)
+    row = _base_row(engine, dt, case, t_run)
+    if case.leading.n == 0:
+        row["note"] = "not assessed: the reference has no leading impact at this scale"
+        return row
+    if blocked:
+        row["skipped"] = blocked
+        return row
+    scene = case.scene.with_run(t_end=t_run)
+    predicted = predict_run_time(engine, scene, dt, row["steps"], measured)
+    row["predicted_wall_time_s"] = predicted
+    if predicted is not None and predicted > budget_s:
+        row["skipped"] = over_budget(predicted, budget_s)
+        return row
+
+    def scored_run() -> dict[str, Any]:
+        traj, wall, err = timed(lambda: run_simulator(engine, scene, dt, t_run))
+        if traj is None:
+            traj = Trajectory.failed(engine, scene.name, dt, err or "")
+        return {**score(traj, case, criteria), "wall_time_s": wall}
+
+    if row["steps"] is None or row["steps"] <= PILOT_FREE_STEPS:  # short: run here
+        return {**row, **scored_run()}
+    cap = HARD_CAP_FACTOR * budget_s
+    result, crashed = run_capped(scored_run, cap)
+    if result is None and crashed is None:
+        row["skipped"] = f"stopped at the hard cap of {cap:g} s (predicted {predicted:.3g} s)"
+        return row
+    if result is None:  # the child died without answering (a crash inside the engine)
+        failed = Trajectory.failed(engine, scene.name, dt, crashed or "")
+        result = {**score(failed, case, criteria), "wall_time_s": None}
+    return {**row, **result}
+
+
+def predict_run_time(
+    engine: str,
+    scene: Scene,
+    dt: float | None,
+    steps: int | None,
+    measured: Sequence[tuple[float, float]],
+) -> float | None:
+    """Predicted wall time of a fixed-step run of `steps` steps: the larger of
+    - two pilot runs' setup + per-step cost (stress.budget.predict_engine_time; runs of
+      more than PILOT_FREE_STEPS steps only), and
+    - the same engine and dt at the smaller scales already run, extrapolated in steps as
+      time ∝ steps^s with s ≥ 1 from the two largest (bench.predict_time): the same
+      motion with fewer steps, so it sees the costly later phases that pilots miss.
+    None for an event-driven engine or a short run with nothing measured."""
+    if dt is None or steps is None:
+        return None
+    guesses = []
+    if measured:
+        guesses.append(predict_time([(1.0 / n, wall) for n, wall in measured], 1.0 / steps))
+    try:
+        guesses.append(predict_engine_time(engine, scene, dt))
+    except SceneError:
+        raise
+    except Exception:  # noqa: BLE001  (the run itself will report the failure)
+        pass
+    guesses = [g for g in guesses if g is not None]
+    return max(guesses) if guesses else None
+
+
+# ----------------------------------------------------------------------------- study
+
+
+def fidelity(
+    scene: Scene,
+    engines: Sequence[str] | None = None,
+    dts: Sequence[float] | None = None,
+    eps: Sequence[float] | None = None,
+    criteria: FidelityCriteria | None = None,
+    window: str = "leading",
+    budget_s: float = DEFAULT_BUDGET_S,
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, Any]:
+    """The fidelity study of `scene` (module docstring; definitions in harness.fidelity).
+    Returns the JSON document: criteria, the reference at every scale, one row per
+    engine, dt and scale, α* per engine and dt, the power-law fit per engine."""
+    say = progress or (lambda _msg: None)
+    criteria = criteria or FidelityCriteria()
+    if criteria.leading < 1:
+        raise SceneError(f"--leading must be >= 1, got {criteria.leading}")
+    if window not in WINDOWS:
+        raise SceneError(f"--window must be one of {', '.join(WINDOWS)}, got {window!r}")
+    engines = list(dict.fromkeys(engines)) if engines else default_engines()
+    dts = sorted({float(d) for d in (dts or DEFAULT_DTS)}, reverse=True)
+    eps = sorted({float(e) for e in (eps or eps_values(*DEFAULT_EPS_GRID))}, reverse=True)
+    plan = [(e, d) for e in engines for d in (dts if is_fixed_step(e) else [None])]
+    load_before = os.getloadavg()
+    start = time.perf_counter()
+    rows: list[dict[str, Any]] = []
+    with progress_bar(len(eps) * (1 + len(plan)), f"fidelity {scene.name}") as bar:
+        cases = []
+        for e in eps:
+            bar.set_postfix_str(f"reference eps={e:.3g}", refresh=False)
+            cases.append(scale_case(scene, e, criteria))
+            bar.update()
+        say(_reference_line(scene, cases))
+        for engine, dt in plan:
+            warm_up(engine, cases[0].scene, dt)
+            rows += _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say)
+    stars = _alpha_stars(rows, plan)
+    return {
+        "kind": "fidelity",
+        "scene": scene.name,
+        "restitution": scene.restitution,
+        "scaling": "q -> eps^2 q, p -> eps p, t -> eps t (t_end scaled too)",
+        "window": window,
+        "criteria": criteria.to_dict(),
+        "engines": engines,
+        "dts": dts,
+        "eps": eps,
+        "budget_s": budget_s,
+        "hard_cap_s": HARD_CAP_FACTOR * budget_s,
+        "reference": [c.to_dict(cases[0]) for c in cases],
+        "runs": rows,
+        "alpha_star": stars,
+        "fits": _fits(stars, engines),
+        "wall_time_s": time.perf_counter() - start,
+        "load": {"before": list(load_before), "after": list(os.getloadavg())},
+        "cpu_count": os.cpu_count(),
+    }
+
+
+def _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say) -> list[dict]:
+    """One engine at one dt over every scale, smallest ε first (budget: module docstring)."""
+    rows, blocked, measured = [], None, []
+    for case in sorted(cases, key=lambda c: c.eps):
+        label = engine if dt is None else f"{engine} dt={dt:g}"
+        bar.set_postfix_str(f"{label} eps={case.eps:.3g}", refresh=False)
+        row = engine_row(engine, dt, case, criteria, window, budget_s, measured, blocked)
+        if row["skipped"] and not blocked:
+            blocked = f"skipped: eps={case.eps:.3g} was not run ({row['skipped']})"
+        if row["wall_time_s"] and row["steps"]:
+            measured.append((row["steps"], row["wall_time_s"]))
+        rows.append(row)
+        say(_run_line(label, row))
+        bar.update()
+    return rows
+
+
+def _alpha_stars(rows: list[dict], plan: list[tuple[str, float | None]]) -> list[dict]:
+    out = []
+    for engine, dt in plan:
+        mine = [r for r in rows if r["engine"] == engine and r["dt"] == dt]
+        out.append({"engine": engine, "dt": dt, **alpha_star(mine)})
+    return out
+
+
+def _fits(stars: list[dict], engines: list[str]) -> list[dict]:
+    """k of α* ∝ dt^k per engine over its "bracket" values (criteria.power_law_fit)."""
+    out = []
+    for engine in engines:
+        mine = [s for s in stars if s["engine"] == engine and s["dt"] is not None]
+        used = [s for s in mine if s["bound"] == "bracket"]
+        fit = power_law_fit([s["dt"] for s in used], [s["alpha_star"] for s in used])
+        fit["dts_used"] = [s["dt"] for s in used]
+        fit["dts_left_out"] = {f"{s['dt']:g}": s["bound"] for s in mine if s["bound"] != "bracket"}
+        out.append({"engine": engine, **fit})
+    return out
+
+
+def _reference_line(scene: Scene, cases: list[ScaleCase]) -> str:
+    c = [f"{x.exponent.c:.3f}" for x in cases if x.exponent.c is not None]
+    return (
+        f"fidelity: {scene.name}: reference at {len(cases)} scales, alpha "
+        f"{cases[0].alpha:.3g} .. {cases[-1].alpha:.3g}, leading impacts "
+        f"{min(x.leading.n for x in cases)}..{max(x.leading.n for x in cases)}, "
+        + (f"c at {len(c)} scales" if c else "no c at any scale")
+    )
+
+
+def _run_line(label: str, row: dict) -> str:
+    text = f"fidelity: {label} eps={row['eps']:.3g} (alpha={row['alpha']:.3g}): "
+    if row["skipped"]:
+        return text + row["skipped"]
+    if row["passes"] is None:
+        return text + row.get("note", "not run")
+    verdict = "pass" if row["passes"] else "fail"
+    wall = "-" if row["wall_time_s"] is None else f"{row['wall_time_s']:.3g} s"
+    return (
+        text + f"{row['leading_matched']}/{row['leading']} leading matched, {verdict} "
+        f"({row['status']}, {wall})"
+    )

@@ -1,0 +1,156 @@
+"""The fidelity study for the terminal: α* per engine and dt with the fitted k, then
+the leading impacts matched at every scale."""
+
+from __future__ import annotations
+
+import math
+import textwrap
+from typing import Any
+
+from ..text import table
+
+WIDTH = 100
+
+
+def alpha_star_text(star: dict[str, Any]) -> str:
+    """'2.8e-04'; '<= 2.8e-10' (passes at every α run); '> 2.8e-02' (fails at the
+    largest); '-' (not measured)."""
+    bound = star["bound"]
+    if bound == "bracket":
+        return f"{star['alpha_star']:.2g}"
+    if bound == "at most":
+        return f"<= {star['alpha_star']:.2g}"
+    if bound == "above grid":
+        return f"> {star['alpha_first_fail']:.2g}"
+    return "-"
+
+
+def fit_text(fit: dict[str, Any]) -> str:
+    """'2.01 ± 0.05 (3 dts)', '2.0 (2 dts, no error)' or '-' with fewer than 2 points."""
+    if fit["k"] is None:
+        return "-"
+    n = fit["n_points"]
+    if fit["k_stderr"] is None:
+        return f"{fit['k']:.2f} ({n} dts, no error)"
+    return f"{fit['k']:.2f} ± {fit['k_stderr']:.2f} ({n} dts)"
+
+
+def dt_label(dt: float | None) -> str:
+    return "event-driven" if dt is None else f"dt={dt:g}"
+
+
+def format_fidelity(doc: dict[str, Any]) -> str:
+    """Header (scaling, criteria, the reference's exponent), the α* table with k, the
+    matched-impacts ladder and the skipped runs."""
+    lines = [textwrap.fill(x, WIDTH, subsequent_indent="  ") for x in header_lines(doc)]
+    lines += ["", _alpha_star_table(doc), "", _ladder(doc)]
+    skipped = [r for r in doc["runs"] if r["skipped"]]
+    for r in skipped:
+        lines.append(
+            f"skipped: {r['engine']} {dt_label(r['dt'])} eps={r['eps']:.3g}: {r['skipped']}"
+        )
+    load = doc["load"]
+    lines.append(
+        f"total {doc['wall_time_s']:.1f} s; load average before {load['before'][0]:.2f}, after "
+        f"{load['after'][0]:.2f}; {doc['cpu_count']} cpus; budget {doc['budget_s']:g} s per run"
+    )
+    return "\n".join(lines)
+
+
+def header_lines(doc: dict[str, Any]) -> list[str]:
+    """What was scaled and run, the criteria, and whether the exponent took part."""
+    refs = doc["reference"]
+    window = (
+        "engines run just past the leading impacts"
+        if doc["window"] == "leading"
+        else "engines run to the scaled scene's end"
+    )
+    return [
+        f"fidelity on {doc['scene']}: {doc['scaling']}; {len(refs)} scales, alpha "
+        f"{refs[0]['alpha']:.3g} .. {refs[-1]['alpha']:.3g}; {window}",
+        f"criteria: {doc['criteria']['rule']}",
+        exponent_line(doc),
+    ]
+
+
+def exponent_line(doc: dict[str, Any]) -> str:
+    """Where the reference has a c, and whether any run was judged on it."""
+    refs = doc["reference"]
+    with_c = [r["c"] for r in refs if r["c"] is not None]
+    judged = sum(1 for r in doc["runs"] if r.get("criterion") == "impacts and c")
+    if not with_c:
+        ends = sorted({r["status"] for r in refs})
+        return (
+            f"the reference has no energy exponent c at any scale (it ends {', '.join(ends)}): "
+            "alpha* rests on the impact criterion alone"
+        )
+    text = (
+        f"reference c = {min(with_c):.3f} .. {max(with_c):.3f} at {len(with_c)} of "
+        f"{len(refs)} scales; "
+    )
+    if judged:
+        return text + f"{judged} engine runs had a c and were judged on it too"
+    why = (
+        "engines stop after the leading impacts (--window scene runs them to the end)"
+        if doc["window"] == "leading"
+        else "no engine run followed the reference to its singularity"
+    )
+    return text + f"no engine run has a c ({why}): alpha* rests on the impact criterion alone"
+
+
+def _alpha_star_table(doc: dict[str, Any]) -> str:
+    dts = sorted({s["dt"] for s in doc["alpha_star"]}, key=lambda d: -(d or math.inf))
+    fits = {f["engine"]: f for f in doc["fits"]}
+    rows = []
+    for engine in doc["engines"]:
+        by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
+        cells = [alpha_star_text(by_dt[d]) if d in by_dt else "" for d in dts]
+        rows.append([engine, *cells, fit_text(fits[engine]) if engine in fits else "-"])
+    header = ["engine", *[dt_label(d) for d in dts], "k of alpha* ~ dt^k"]
+    return (
+        "alpha* (smallest inclination passed; '<=': passes at every scale run, "
+        "'>': fails at the largest)\n" + table(rows, header, "l" + "r" * (len(header) - 1))
+    )
+
+
+def ladder_cell(row: dict[str, Any]) -> str:
+    """Leading impacts matched, 'x' when the run fails, 's' skipped, '-' not assessed."""
+    if row["skipped"]:
+        return "s"
+    if row["passes"] is None:
+        return "-"
+    return f"{row['leading_matched']}{'' if row['passes'] else 'x'}"
+
+
+def ladder_char(row: dict[str, Any] | None) -> str:
+    """One character per scale: '+' passes, '0'..'9' fails (tenths of the leading
+    impacts matched), 's' skipped for the budget, '.' not assessed, ' ' not run."""
+    if row is None:
+        return " "
+    if row["skipped"]:
+        return "s"
+    if row["passes"] is None:
+        return "."
+    if row["passes"]:
+        return "+"
+    return str(min(9, int(10 * (row.get("match_fraction") or 0.0))))
+
+
+def _ladder(doc: dict[str, Any]) -> str:
+    refs = doc["reference"]
+    groups: dict[tuple[str, Any], dict[float, dict]] = {}
+    for r in doc["runs"]:
+        groups.setdefault((r["engine"], r["dt"]), {})[r["eps"]] = r
+    rows = [
+        [
+            engine,
+            "-" if dt is None else f"{dt:.0e}",
+            " ".join(ladder_char(by_eps.get(e)) for e in doc["eps"]),
+        ]
+        for (engine, dt), by_eps in groups.items()
+    ]
+    header = ["engine", "dt", f"alpha {refs[0]['alpha']:.1e} -> {refs[-1]['alpha']:.1e}"]
+    return (
+        "each scale, largest alpha first: + passes, 0-9 fails (tenths of the leading impacts "
+        "matched), s skipped (budget), . not assessed\n" + table(rows, header, "lll")
+    )

@@ -1,0 +1,161 @@
+"""`harness report`: one self-contained HTML file from result documents.
+
+Inputs (any number, in the order given):
+
+- a JSON document of `harness compare --json`, `bench --json` / `--out`, `fidelity
+  --json` / `--out`, `stress --json` or `sweep exponent --json`;
+- a sweep directory: ROOT/<engine> (holding manifest.json and parts/), or a study
+  directory ROOT holding several of them (one section per engine).
+
+The kind of a document is recognised from its fields (`detect_kind`).  Each gets a
+section: its tables, its verdicts, its figures and its provenance (the command that made
+it, when, on what machine, with every version: harness.provenance).
+
+How the report finds the plots: it does not.  Every figure is redrawn from the data in
+the document (work-precision from the bench rows, α* and matched fractions from the
+fidelity rows, the exponent map from the sweep's per-point means), by the same functions
+the commands use, and embedded as a PNG data URI.  The file loads nothing from anywhere:
+no scripts, no external styles, fonts or images; it opens offline in any browser and
+can be mailed or archived alone.  The one link out is to a compare run's `.rrd`
+recording (relative to the report's folder), which the browser cannot show anyway.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .html import details, esc, page
+from .sections import (
+    bench_section,
+    compare_section,
+    fidelity_section,
+    provenance_section,
+    stress_section,
+    sweep_command,
+    sweep_section,
+)
+
+KINDS = ("compare", "bench", "fidelity", "stress", "sweep")
+
+
+class ReportInputError(ValueError):
+    """An input that is not a result document (bad input: exit status 2)."""
+
+
+@dataclass
+class ReportInput:
+    path: Path
+    kind: str
+    doc: dict[str, Any]
+    rebuilt_command: str | None = None  # sweep directories: the command from the manifest
+
+
+def detect_kind(doc: Any) -> str | None:
+    """'compare', 'bench', 'fidelity', 'stress' or 'sweep' from a document's fields."""
+    if not isinstance(doc, dict):
+        return None
+    if doc.get("kind") in KINDS:
+        return doc["kind"]
+    if str(doc.get("command", "")).startswith("sweep"):
+        return "sweep"
+    if "truth" in doc and "results" in doc:
+        return "bench"
+    if "cases" in doc and "thresholds" in doc:
+        return "stress"
+    engines = doc.get("engines")
+    if (
+        "reference" in doc
+        and isinstance(engines, list)
+        and engines
+        and "impacts_matched" in engines[0]
+    ):
+        return "compare"
+    return None
+
+
+def load_inputs(path: str | Path) -> list[ReportInput]:
+    """The result documents at `path`: one for a JSON file, one per engine for a sweep
+    directory."""
+    p = Path(path)
+    if p.is_dir():
+        return _sweep_directory(p)
+    if not p.is_file():
+        raise ReportInputError(f"{p}: no such file or directory")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ReportInputError(f"{p}: not a JSON document ({exc})") from None
+    kind = detect_kind(doc)
+    if kind is None:
+        raise ReportInputError(
+            f"{p}: not a result of harness compare, bench, fidelity, stress or sweep"
+        )
+    return [ReportInput(p, kind, doc)]
+
+
+def _sweep_directory(p: Path) -> list[ReportInput]:
+    """A sweep's own directory (manifest.json + parts/) or a study directory of them:
+    the same summary `harness sweep exponent` prints, from the stored parts."""
+    from ..sweep import summarise
+    from ..sweep.store import SweepStore, engines_in, load_results, read_manifest
+
+    own = read_manifest(p)
+    found = {own.engine: (p.parent, own)} if own else {}
+    if not found:
+        found = {e: (p, c) for e, c in engines_in(p).items()}
+    if not found:
+        raise ReportInputError(f"{p}: a directory without a sweep (no manifest.json)")
+    out = []
+    for _engine, (root, config) in found.items():
+        store = SweepStore(root, config)  # not opened: read only, no lock
+        df, duplicates = load_results(store.dir)
+        doc = summarise(config, df, store, {}, len(df), 0, duplicates)
+        out.append(ReportInput(store.dir, "sweep", doc, sweep_command(config)))
+    return out
+
+
+def _title(item: ReportInput) -> str:
+    doc = item.doc
+    what = doc.get("scene") or doc.get("engine") or ""
+    return f"{item.kind}: {what}" if what else item.kind
+
+
+def section(item: ReportInput, out_dir: Path) -> str:
+    """The HTML section of one input: its kind's tables and figures, then provenance."""
+    doc = item.doc
+    if item.kind == "compare":
+        body = compare_section(doc, out_dir)
+    elif item.kind == "bench":
+        body = bench_section(doc)
+    elif item.kind == "fidelity":
+        body = fidelity_section(doc)
+    elif item.kind == "stress":
+        body = stress_section(doc)
+    else:
+        body = sweep_section(doc)
+    return (
+        f"<section><h2>{esc(_title(item))}</h2>"
+        f"<p class=muted>from <code>{esc(item.path)}</code></p>\n{body}\n"
+        f"{provenance_section(doc, item.rebuilt_command)}</section>"
+    )
+
+
+def build_report(items: list[ReportInput], out_path: str | Path, own: dict[str, Any]) -> str:
+    """The whole HTML page.  `own` is the report command's provenance (shown last)."""
+    out_dir = Path(out_path).resolve().parent
+    contents = "".join(f"<li>{esc(_title(i))} <code>{esc(i.path)}</code></li>" for i in items)
+    body = [f"<p>Results in this report:</p><ul>{contents}</ul>"]
+    body += [section(i, out_dir) for i in items]
+    body.append(
+        details(
+            "how this report was made",
+            f"<pre>{esc(own['command'])}</pre><p class=muted>{esc(own['created'])}, "
+            f"{esc(own['host'])}. Figures are redrawn from the inputs' data and embedded; "
+            "the page loads nothing from elsewhere.</p>",
+        )
+    )
+    title = "harness report: " + ", ".join(_title(i) for i in items)
+    return page(title, "\n".join(body))

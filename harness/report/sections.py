@@ -1,0 +1,442 @@
+"""One HTML section per kind of result document.  Every figure is redrawn from the
+document's own data (bench rows → work-precision, fidelity rows → α* and matched
+fractions, sweep points → exponent map), so a report depends on no file but its inputs."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from .html import Cell, details, esc, figure, num, paragraph, table
+
+# ----------------------------------------------------------------------------- provenance
+
+
+def provenance_section(doc: dict[str, Any], rebuilt_command: str | None = None) -> str:
+    """The command that made the document, when, where, and every version."""
+    prov = doc.get("provenance")
+    if not prov:
+        text = "<h3>Provenance</h3>"
+        if rebuilt_command:
+            return text + (
+                "<p>Equivalent command, rebuilt from the sweep's manifest.json (the directory "
+                f"records no provenance):</p><pre>{esc(rebuilt_command)}</pre>"
+            )
+        return text + paragraph(
+            "Not recorded: this document was made before results carried a provenance object.",
+            "muted",
+        )
+    versions = [[k, v] for k, v in sorted(prov.get("versions", {}).items())]
+    return (
+        "<h3>Provenance</h3>"
+        f"<p>Command:</p><pre>{esc(prov.get('command', '-'))}</pre>"
+        f"<p>Created {esc(prov.get('created', '-'))} on {esc(prov.get('host', '-'))}.</p>"
+        + table(["package", "version"], versions, "versions (importlib.metadata)", left=2)
+    )
+
+
+# ----------------------------------------------------------------------------- compare
+
+
+def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
+    ref = doc["reference"]
+    exp = ref.get("exponent") or {}
+    parts = [
+        paragraph(
+            f"Scene {doc['scene']} (restitution {doc.get('restitution')}): the reference ended "
+            f"{ref['status']} at t = {num(ref['t_final'], '.6g')} after {ref.get('n_impacts')} "
+            f"impacts ({num(ref.get('wall_time_s'), '.2g')} s); "
+            + (f"c = {exp['c']:.3f}." if exp.get("c") is not None else "no energy exponent c.")
+        )
+    ]
+    rows = []
+    for e in doc["engines"]:
+        c = (e.get("exponent") or {}).get("c")
+        rows.append(
+            [
+                e["engine"],
+                num(e["dt"], "g"),
+                e["status"],
+                f"{e['impacts_matched']}/{e['reference_impacts']}",
+                num(e["first_divergence_time"], ".4g"),
+                num(e["energy_error_agreeing"], ".2e"),
+                num(e["impact_time_error"], ".2e"),
+                num(c, ".3f"),
+                num(e["wall_time_s"], ".3g"),
+            ]
+        )
+    parts.append(
+        table(
+            [
+                "engine",
+                "dt",
+                "status",
+                "matched",
+                "diverges at",
+                "E err",
+                "t err [s]",
+                "c",
+                "wall [s]",
+            ],
+            rows,
+            "runs against the reference (docs/output.md defines every column)",
+        )
+    )
+    parts.append("<h3>Verdicts</h3>")
+    parts += [paragraph(e["verdict"], "verdict") for e in doc["engines"] if e.get("verdict")]
+    first = doc.get("first_to_diverge")
+    if first:
+        parts.append(paragraph(f"First to diverge: {first['why']}"))
+    parts.append(recording_link(doc.get("recording"), out_dir))
+    return "\n".join(parts)
+
+
+def recording_link(path: str | None, out_dir: Path) -> str:
+    """A relative link to the run's .rrd recording (open it with `rerun FILE`)."""
+    if not path:
+        return paragraph("No recording was made (compare --record FILE.rrd makes one).", "muted")
+    target = Path(path)
+    href = os.path.relpath(target.resolve(), out_dir.resolve())
+    found = "" if target.exists() else " (not found when this report was written)"
+    return (
+        f'<p>Recording: <a href="{esc(href)}">{esc(target.name)}</a>{esc(found)}; open it with '
+        f"<code>rerun {esc(target.name)}</code> (docs/recording.md).</p>"
+    )
+
+
+# ----------------------------------------------------------------------------- bench
+
+
+def bench_section(doc: dict[str, Any]) -> str:
+    from ..bench import work_precision_figure
+
+    tr = doc["truth"]
+    parts = [
+        paragraph(
+            f"Scene {doc['scene']}, t = 0 .. {num(doc['t_end'], '.6g')}; truth: reference "
+            f"{tr['setting']} ({tr['status']}, {tr['impacts']} impacts); median of "
+            f"{doc['repeats']} runs after a warm-up; budget {num(doc['budget_s'], 'g')} s "
+            "per setting."
+        )
+    ]
+    rows = [
+        [
+            r["engine"],
+            r["setting"],
+            r["status"],
+            num(r["wall_time_s"], ".3g"),
+            f"{r['impacts_matched']}/{r['reference_impacts']}",
+            num(r["impact_time_error"], ".2e"),
+            num(r["energy_error"], ".2e"),
+            num(r["energy_error_agreeing"], ".2e"),
+        ]
+        for r in doc["results"]
+    ]
+    header = [
+        "engine",
+        "setting",
+        "status",
+        "median [s]",
+        "matched",
+        "t err [s]",
+        "E err",
+        "E err<div",
+    ]
+    parts.append(table(header, rows, "work-precision rows", left=2))
+    for s in doc.get("skipped", []):
+        parts.append(paragraph(f"skipped: {s['engine']} {s['setting']}: {s['reason']}", "muted"))
+    derived = doc.get("derived", {}).get("energy_error_agreeing", {})
+    if derived:
+        drows = [
+            [
+                eng,
+                num(d["error_at_reference_cost"], ".2e"),
+                d["error_at_reference_cost_bound"],
+                num(d["best_error"], ".2e"),
+                num(d["cost_ratio"], ".3g"),
+                d["cost_ratio_bound"] or "-",
+            ]
+            for eng, d in derived.items()
+        ]
+        parts.append(
+            table(
+                ["engine", "error at reference cost", "bound", "best error", "cost ratio", "bound"],
+                drows,
+                "energy error before divergence: at the reference's cost, and cost at equal "
+                "accuracy over the reference's",
+            )
+        )
+    parts.append(
+        figure(
+            work_precision_figure(doc),
+            f"work-precision on {doc['scene']}",
+            "Work-precision, redrawn from the rows above.",
+        )
+    )
+    return "\n".join(parts)
+
+
+# ----------------------------------------------------------------------------- fidelity
+
+
+def fidelity_section(doc: dict[str, Any]) -> str:
+    from ..fidelity import alpha_star_figure, matched_figure
+    from ..fidelity.text import alpha_star_text, dt_label, fit_text, header_lines, ladder_cell
+
+    parts = [paragraph(line) for line in header_lines(doc)]
+    dts = sorted(
+        {s["dt"] for s in doc["alpha_star"]}, key=lambda d: -(d if d is not None else 1e300)
+    )
+    fits = {f["engine"]: f for f in doc["fits"]}
+    rows = []
+    for engine in doc["engines"]:
+        by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
+        cells = [
+            Cell(alpha_star_text(by_dt[d]), _star_class(by_dt[d]), by_dt[d]["bound"])
+            if d in by_dt
+            else ""
+            for d in dts
+        ]
+        rows.append([engine, *cells, fit_text(fits[engine]) if engine in fits else "-"])
+    parts.append(
+        table(
+            ["engine", *[dt_label(d) for d in dts], "k of α* ∝ dt^k (± standard error)"],
+            rows,
+            "α*: the smallest inclination the engine follows ('<=' passes at every scale run, "
+            "'>' fails at the largest)",
+        )
+    )
+    parts.append(figure(alpha_star_figure(doc), f"alpha* against dt on {doc['scene']}"))
+    parts.append(_ladder_table(doc, ladder_cell))
+    parts.append(figure(matched_figure(doc), f"leading impacts matched on {doc['scene']}"))
+    parts.append(_fidelity_reference_table(doc))
+    parts.append(details(f"every run ({len(doc['runs'])})", _fidelity_runs_table(doc)))
+    skipped = [r for r in doc["runs"] if r["skipped"]]
+    for r in skipped:
+        parts.append(
+            paragraph(
+                f"skipped: {r['engine']} {dt_label(r['dt'])} ε = {r['eps']:.3g}: {r['skipped']}",
+                "muted",
+            )
+        )
+    return "\n".join(parts)
+
+
+def _star_class(star: dict[str, Any]) -> str:
+    return {"bracket": "pass", "at most": "pass", "above grid": "fail"}.get(star["bound"], "na")
+
+
+def _ladder_table(doc: dict[str, Any], ladder_cell) -> str:
+    alphas = {r["eps"]: r["alpha"] for r in doc["reference"]}
+    groups: dict[tuple, dict[float, dict]] = {}
+    for r in doc["runs"]:
+        groups.setdefault((r["engine"], r["dt"]), {})[r["eps"]] = r
+    rows = []
+    for (engine, dt), by_eps in groups.items():
+        cells = []
+        for e in doc["eps"]:
+            r = by_eps.get(e)
+            if r is None:
+                cells.append("")
+                continue
+            cls = "skip" if r["skipped"] else ("na" if r["passes"] is None else "")
+            cls = cls or ("pass" if r["passes"] else "fail")
+            cells.append(Cell(ladder_cell(r), cls, r["skipped"] or r.get("first_mismatch") or ""))
+        rows.append([engine, num(dt, ".0e"), *cells])
+    header = ["engine", "dt", *[f"{alphas[e]:.1e}" for e in doc["eps"]]]
+    return table(
+        header,
+        rows,
+        f"leading impacts matched (of {doc['criteria']['leading']}) at each α: green passes, "
+        "red fails ('x'), grey skipped for the budget ('s')",
+        left=2,
+    )
+
+
+def _fidelity_reference_table(doc: dict[str, Any]) -> str:
+    rows = [
+        [
+            num(r["eps"], ".3g"),
+            num(r["alpha"], ".3g"),
+            r["status"],
+            r["impacts"],
+            r["leading"],
+            num(r["leading_t_last_scaled"], ".4g"),
+            num(r["c"], ".3f"),
+            num(r["same_contacts_as_first"]),
+            num(r["scaled_time_shift"], ".2e"),
+        ]
+        for r in doc["reference"]
+    ]
+    header = [
+        "ε",
+        "α",
+        "status",
+        "impacts",
+        "leading",
+        "last leading t/ε",
+        "c",
+        "same contacts",
+        "t/ε shift",
+    ]
+    return table(
+        header,
+        rows,
+        "the reference at each scale (same contacts and t/ε shift: against the largest scale)",
+        left=0,
+    )
+
+
+def _run_verdict(r: dict[str, Any]) -> Cell:
+    """'pass' / 'fail' / 'skipped' / '-' (not assessed), coloured, the reason as tooltip."""
+    if r["skipped"]:
+        return Cell("skipped", "skip", r["skipped"])
+    if r["passes"] is None:
+        return Cell("-", "na", r.get("note") or "")
+    return Cell("pass" if r["passes"] else "fail", "pass" if r["passes"] else "fail", r["c_check"])
+
+
+def _fidelity_runs_table(doc: dict[str, Any]) -> str:
+    rows = [
+        [
+            r["engine"],
+            num(r["dt"], "g"),
+            num(r["eps"], ".3g"),
+            num(r["alpha"], ".3g"),
+            r.get("status") or "-",
+            "-" if r["passes"] is None else f"{r['leading_matched']}/{r['leading']}",
+            num(r.get("impact_time_error_scaled"), ".2e"),
+            num(r.get("energy_error"), ".2e"),
+            num(r.get("c"), ".3f"),
+            _run_verdict(r),
+            num(r.get("wall_time_s"), ".3g"),
+        ]
+        for r in doc["runs"]
+    ]
+    header = ["engine", "dt", "ε", "α", "status", "leading", "t err/ε", "E err", "c", "verdict"]
+    return table([*header, "wall [s]"], rows, left=1)
+
+
+# ----------------------------------------------------------------------------- sweep
+
+
+def sweep_section(doc: dict[str, Any]) -> str:
+    from ..sweep.grid import SweepConfig
+    from ..sweep.plots import Boundaries, exponent_map_figure, sweep_label
+
+    config = SweepConfig.from_dict(doc["manifest"])
+    stats = points_frame(doc["points"], config)
+    g, t = doc["grid"], doc["tasks"]
+    counts = ", ".join(f"{k} {v}" for k, v in doc.get("counts", {}).items() if v)
+    parts = [
+        paragraph(
+            f"Exponent sweep: engine {doc['engine']}, n = {doc['n']}, "
+            f"{len(g['restitution'])} γ × {len(g['gyration'])} ρ × {g['samples']} runs, seed "
+            f"{g['seed']}; {t['rows']} of {t['total']} runs stored; status: {counts or '-'}; "
+            f"mean c over all runs {num(doc.get('mean_c'), '.3f')}."
+        ),
+        figure(
+            exponent_map_figure(stats, config, Boundaries(config), sweep_label(config)),
+            f"exponent map of the {doc['engine']} sweep",
+            "Mean energy exponent c per grid point, redrawn from the per-point means.",
+        ),
+    ]
+    rows = [
+        [
+            num(p["restitution"], ".3g"),
+            num(p["gyration"], ".3g"),
+            p["runs"],
+            p["n_c"],
+            num(p["mean_c"], ".3f"),
+            num(p["std_c"], ".3f"),
+            num(p["frac_simultaneous"], ".2f"),
+        ]
+        for p in doc["points"]
+    ]
+    header = ["γ", "ρ", "runs", "with c", "mean c", "std c", "simultaneous"]
+    parts.append(details(f"every grid point ({len(rows)})", table(header, rows, left=0)))
+    return "\n".join(parts)
+
+
+def points_frame(points: list[dict[str, Any]], config):
+    """The sweep summary's per-point rows as the statistics frame the map is drawn from
+    (grid indices recovered as the nearest grid value)."""
+    import numpy as np
+    import pandas as pd
+
+    gam, rho = config.gamma_values, config.rho_values
+    return pd.DataFrame(
+        {
+            "i_restitution": [int(np.argmin(np.abs(gam - p["restitution"]))) for p in points],
+            "i_gyration": [int(np.argmin(np.abs(rho - p["gyration"]))) for p in points],
+            "mean_c": [np.nan if p["mean_c"] is None else p["mean_c"] for p in points],
+        }
+    )
+
+
+def sweep_command(config) -> str:
+    """The `harness sweep exponent` command that makes (or resumes) this sweep."""
+    import shlex
+
+    def g(t) -> str:
+        return f"{t[0]:g}:{t[1]:g}:{t[2]}"
+
+    args = [
+        "harness", "sweep", "exponent", "--n", str(config.n), "--gyration", g(config.gyration),
+        "--restitution", g(config.restitution), "--samples", str(config.samples),
+        "--seed", str(config.seed), "--engine", config.engine,
+    ]  # fmt: skip
+    if config.dt is not None:
+        args += ["--dt", f"{config.dt:g}"]
+    if config.engine != "linear":
+        args += ["--t-end", f"{config.t_end:g}"]
+    return shlex.join([*args, "--out", "ROOT"])
+
+
+# ----------------------------------------------------------------------------- stress
+
+
+def stress_section(doc: dict[str, Any]) -> str:
+    rows = []
+    for r in doc["cases"]:
+        v = r["verdict"]
+        cls = {"ok": "pass", "failed": "fail"}.get(v, "skip" if v.startswith("skipped") else "")
+        rows.append(
+            [
+                r["case"],
+                r["engine"],
+                Cell(v, cls, r.get("reason") or ""),
+                r["status"] or "-",
+                num(r["energy_gain"], ".2e"),
+                num(r.get("penetration_relative"), ".2e"),
+                num(r["missed_impacts"]),
+                num(r["spurious_impacts"]),
+                num(r.get("wall_time_s"), ".2f"),
+            ]
+        )
+    header = [
+        "case",
+        "engine",
+        "verdict",
+        "status",
+        "E gain",
+        "pen/L",
+        "missed",
+        "spurious",
+        "wall [s]",
+    ]
+    parts = [
+        paragraph(
+            f"Fixed-step engines at dt = {doc['dt']:g}, budget {doc['budget_s']:g} s per run."
+        ),
+        table(header, rows, "verdict per case and simulator", left=2),
+    ]
+    reasons = [
+        f"{r['case']} / {r['engine']}: {r['verdict']}: {r['reason']}"
+        for r in doc["cases"]
+        if r["verdict"] != "ok" and r.get("reason")
+    ]
+    if reasons:
+        parts.append(details(f"reasons ({len(reasons)})", "".join(paragraph(x) for x in reasons)))
+    return "\n".join(parts)
