@@ -41,6 +41,7 @@ from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
 from ..metrics import evaluate
+from ..progress import progress_bar
 from ..simulators import check_engine, engine_names, is_fixed_step, run_simulator
 from ..text import table
 
@@ -218,40 +219,43 @@ def bench(
         )
         return row
 
-    for engine in _ordered(engines):
-        if engine == "reference":
-            for rc in ref_settings:
-                measure(reference_setting(rc))
-        elif not is_fixed_step(engine):
-            setting = Setting(engine)
-            timed(setting, scene, horizon)  # warm-up (e.g. numba compilation)
-            measure(setting)
-        else:
-            timed(Setting(engine, dt=dts[0]), scene, horizon)  # warm-up
-            measured: list[tuple[float, float]] = []
-            for i, dt in enumerate(dts):
-                setting = Setting(engine, dt=dt)
-                if measured:
-                    predicted = predict_time(measured, dt)
-                    if repeats * predicted > budget_s:
-                        for dt_skip in dts[i:]:
-                            p = predict_time(measured, dt_skip)
-                            skipped.append(
-                                {
-                                    "engine": engine,
-                                    "setting": f"dt={dt_skip:g}",
-                                    "dt": dt_skip,
-                                    "predicted_wall_time_s": p,
-                                    "reason": f"predicted {repeats} x {p:.3g} s > budget "
-                                    f"{budget_s:g} s",
-                                }
-                            )
-                            say(f"bench: {engine} dt={dt_skip:g}: skipped ({p:.3g} s predicted)")
-                        break
-                row = measure(setting)
-                measured.append((dt, row["wall_time_s"]))
-    if "reference" not in engines:  # the truth setting is always timed
-        measure(truth_setting)
+    plan = _ordered(engines)
+    total = len(ref_settings) if "reference" in engines else 1
+    total += sum(len(dts) if is_fixed_step(e) else 1 for e in plan if e != "reference")
+    with progress_bar(total, f"bench {scene.name}", unit="setting") as bar:
+
+        def measured_once(setting: Setting) -> dict[str, Any]:
+            bar.set_postfix_str(f"{setting.engine} {setting.label}", refresh=False)
+            row = measure(setting)
+            bar.update()
+            return row
+
+        def skip(engine: str, dt: float, predicted: float) -> None:
+            skipped.append(
+                {
+                    "engine": engine,
+                    "setting": f"dt={dt:g}",
+                    "dt": dt,
+                    "predicted_wall_time_s": predicted,
+                    "reason": f"predicted {repeats} x {predicted:.3g} s > budget {budget_s:g} s",
+                }
+            )
+            say(f"bench: {engine} dt={dt:g}: skipped ({predicted:.3g} s predicted)")
+            bar.update()
+
+        for engine in plan:
+            if engine == "reference":
+                for rc in ref_settings:
+                    measured_once(reference_setting(rc))
+            elif not is_fixed_step(engine):
+                setting = Setting(engine)
+                timed(setting, scene, horizon)  # warm-up (e.g. numba compilation)
+                measured_once(setting)
+            else:
+                timed(Setting(engine, dt=dts[0]), scene, horizon)  # warm-up
+                _sweep_timesteps(engine, dts, measured_once, skip, repeats, budget_s)
+        if "reference" not in engines:  # the truth setting is always timed
+            measured_once(truth_setting)
 
     derived = derive(results)
     doc: dict[str, Any] = {
@@ -287,6 +291,20 @@ def bench(
         doc["plot"] = str(plot_work_precision(doc, plot))
         say(f"bench: wrote {doc['plot']}")
     return doc
+
+
+def _sweep_timesteps(engine, dts, measure, skip, repeats: int, budget_s: float) -> None:
+    """A fixed-step engine from the coarsest dt to the finest: each setting predicted from
+    the ones measured (`predict_time`); once `repeats` × the prediction exceeds the
+    budget, that dt and every finer one are skipped."""
+    measured: list[tuple[float, float]] = []
+    for i, dt in enumerate(dts):
+        if measured and repeats * predict_time(measured, dt) > budget_s:
+            for dt_skip in dts[i:]:
+                skip(engine, dt_skip, predict_time(measured, dt_skip))
+            return
+        row = measure(Setting(engine, dt=dt))
+        measured.append((dt, row["wall_time_s"]))
 
 
 def _ordered(engines: list[str]) -> list[str]:

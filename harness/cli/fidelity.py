@@ -50,7 +50,7 @@ def register(sub) -> None:
         "--window",
         choices=WINDOWS,
         default="leading",
-        help="run engines just past the leading impacts (default) or to the scaled scene's end",
+        help="run engines just past the leading impacts (default) or to the reference's end",
     )
     f.add_argument(
         "--budget",

@@ -25,6 +25,7 @@ from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
 from ..metrics import RunMetrics, effective_restitution, evaluate, run_exponent
+from ..progress import progress_bar
 from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator, warm_up
 
 
@@ -118,11 +119,15 @@ def compare(
     with its wall time (for stderr)."""
     say = progress or (lambda _msg: None)
     dts = list(dts) if dts else [DEFAULT_DT]
-    reference, ref_wall = _timed_run("reference", scene, None, t_end, reraise=True)
-    say(_progress_line("reference", None, reference, ref_wall))
+    plan = [(e, dt) for e in engines for dt in (dts if is_fixed_step(e) else [None])]
     runs: list[EngineRun] = []
-    for engine in engines:
-        for dt in dts if is_fixed_step(engine) else [None]:
+    with progress_bar(1 + len(plan), f"compare {scene.name}") as bar:
+        bar.set_postfix_str("reference", refresh=False)
+        reference, ref_wall = _timed_run("reference", scene, None, t_end, reraise=True)
+        say(_progress_line("reference", None, reference, ref_wall))
+        bar.update()
+        for engine, dt in plan:
+            bar.set_postfix_str(engine if dt is None else f"{engine} dt={dt:g}", refresh=False)
             if engine == "reference":
                 traj, wall = reference, ref_wall
             else:
@@ -131,6 +136,7 @@ def compare(
             metrics = evaluate(traj, reference, scene.gravity)
             fit = run_exponent(traj, scene, reference, metrics.match)
             runs.append(EngineRun(engine, dt, traj, wall, metrics, fit))
+            bar.update()
     return CompareResult(scene, reference, ref_wall, runs, run_exponent(reference, scene))
 
 

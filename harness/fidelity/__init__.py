@@ -16,8 +16,8 @@ Definitions (all stated in the JSON document and the text output):
   are not chatter tails (leading.py: why, and how chaotic divergence stays out).
 - **window**: `--window leading` (default) runs every engine just past the last leading
   impact (leading.run_end), so the cost of a scale does not include the chaotic end
-  that no engine follows; `--window scene` runs it to the scaled scene's end, which the
-  exponent criterion needs.
+  that no engine follows; `--window whole` runs it to the reference's end (the whole
+  motion), which the exponent criterion needs.
 - **metrics of a run** (harness.metrics.evaluate against the reference at the same
   scale): leading impacts matched (same contact, time within 3·dt + 1 %·t capped by
   the gaps, in order), impact-time error (max |t − t_ref| over them, in seconds and

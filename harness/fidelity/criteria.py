@@ -120,15 +120,37 @@ def _bound(star, first_fail, ran) -> str:
     return "at most" if first_fail is None else "bracket"
 
 
-def power_law_fit(dts: Sequence[float], alphas: Sequence[float]) -> dict[str, Any]:
-    """k, its standard error and log10 A of α* = A dt^k (least squares in log-log)."""
+def power_law_fit(
+    dts: Sequence[float], alphas: Sequence[float], fails: Sequence[float] | None = None
+) -> dict[str, Any]:
+    """k, its standard error and log10 A of α* = A dt^k (least squares in log-log).
+
+    `fails`: the first failing α below each α* (the bracket).  The true threshold lies in
+    (α_fail, α*], so log10 α* overstates it by u_i ∈ [0, s_i), s_i = log10(α*/α_fail),
+    and the slope k = Σ w_i y_i (w_i = (x_i − x̄)/Σ(x − x̄)²) by Σ w_i u_i: `k_grid` is
+    the interval [k − Σ_{w>0} w_i s_i, k − Σ_{w<0} w_i s_i] that the grid's resolution
+    leaves for k (the standard error says how far the points are from a line, this how
+    far the line can move inside the brackets)."""
     x = np.log10(np.asarray(dts, dtype=float))
     y = np.log10(np.asarray(alphas, dtype=float))
     n = len(x)
-    out: dict[str, Any] = {"k": None, "k_stderr": None, "log10_A": None, "n_points": n}
+    out: dict[str, Any] = {
+        "k": None,
+        "k_stderr": None,
+        "k_grid": None,
+        "log10_A": None,
+        "n_points": n,
+    }
     if n < 2 or np.ptp(x) == 0:
         return out
     k, b, se, rms = ordinary_least_squares(x, y)
     out.update(k=k, log10_A=b, rms_residual_decades=rms)
     out["k_stderr"] = se if n >= 3 and math.isfinite(se) else None
+    if fails is not None:
+        steps = y - np.log10(np.asarray(fails, dtype=float))
+        w = (x - x.mean()) / np.sum((x - x.mean()) ** 2)
+        out["k_grid"] = [
+            k - float(np.sum((w * steps)[w > 0])),
+            k - float(np.sum((w * steps)[w < 0])),
+        ]
     return out

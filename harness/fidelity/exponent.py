@@ -5,8 +5,8 @@ energy above rest, reference.geometry.excess_energy), with harness.metrics.run_e
 deciding which t_f a run may use: its own singularity, or the reference's when it
 followed the reference there impact for impact; any other run has no c.  A fixed-step
 engine stopped at the end of the leading impacts never has one, so the exponent
-criterion applies only with `--window scene`, and only to runs that reach the
-reference's singularity.
+criterion applies only with `--window whole`, and only to runs that follow the
+reference to its singularity.
 """
 
 from __future__ import annotations

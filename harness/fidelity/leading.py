@@ -64,21 +64,28 @@ def leading_impacts(reference: Trajectory, n: int, gravity: float) -> LeadingImp
     return LeadingImpacts(idx, float(t[last]), t_next, speed)
 
 
-def run_end(leading: LeadingImpacts, scene_end: float, dt: float | None, window: str) -> float:
-    """How long an engine runs at this scale.
+def run_end(
+    leading: LeadingImpacts,
+    reference_end: float,
+    scene_end: float,
+    dt: float | None,
+    window: str,
+) -> float:
+    """How long an engine runs at this scale: a margin past a time t_w, never past the
+    scaled scene's end ε·t_end.
 
-    window "scene": the scaled scene's end, ε·t_end (needed for an exponent c: only a
-    run to the end of the motion has one).  window "leading": just past the last leading
-    impact, t_last + max(half the gap to the reference's next impact, the matching
-    window 3·dt + 1 %·t_last of harness.metrics.match_tolerance), so that a run impact
-    late by up to the matching window still counts; never past ε·t_end.  This end
-    scales with ε like the motion."""
-    if window == "scene" or leading.t_last is None:
+    window "leading": t_w = the last leading impact.  window "whole": t_w = the
+    reference's end (its singularity, undecidable impact or t_end): the whole motion,
+    which an exponent c needs (only a run to the end of the motion has one).  The margin
+    is the matching window of harness.metrics.match_tolerance, 3·dt + 1 %·t_w (so that a
+    run impact late by up to it still counts), and for "leading" at least half the gap
+    to the reference's next impact.  Both ends scale with ε like the motion."""
+    if leading.t_last is None and window == "leading":
         return scene_end
-    t = leading.t_last
+    t = leading.t_last if window == "leading" else reference_end
     absolute = STEPS_TIME_TOLERANCE * dt if dt is not None else EVENT_TIME_TOLERANCE
     margin = absolute + RELATIVE_TIME_TOLERANCE * t
-    if leading.t_next is not None:
+    if window == "leading" and leading.t_next is not None:
         margin = max(margin, 0.5 * (leading.t_next - t))
     return min(scene_end, t + margin)
 

@@ -93,7 +93,7 @@ def matched_figure(doc: dict[str, Any]):
     dts = sorted({r["dt"] for r in doc["runs"]}, key=lambda d: -(d if d is not None else 1e300))
     n = max(len(dts), 1)
     fig, axes = plt.subplots(
-        1, n, figsize=(4.2 * n, 3.8), layout="constrained", sharey=True, squeeze=False
+        1, n, figsize=(4.2 * n, 4.2), layout="constrained", sharey=True, squeeze=False
     )
     threshold = doc["criteria"]["match_fraction"]
     for ax, dt in zip(axes[0], dts, strict=False):
@@ -116,7 +116,8 @@ def matched_figure(doc: dict[str, Any]):
         ax.set_title("event-driven" if dt is None else f"dt = {dt:g} s", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
     axes[0][0].set_ylabel(f"fraction of {doc['criteria']['leading']} leading impacts matched")
-    axes[0][-1].legend(fontsize=7, loc="lower right")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncol=min(len(labels), 6), fontsize=7)
     fig.suptitle(
         f"leading impacts matched on '{doc['scene']}' (dashed: pass threshold)", fontsize=9
     )

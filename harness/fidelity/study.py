@@ -51,7 +51,7 @@ from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
 DEFAULT_DTS = (1e-3, 1e-4, 1e-5)
 DEFAULT_EPS_GRID = (1.0, 1e-4, 17)  # first, last, count: log-spaced, α half a decade apart
 DEFAULT_BUDGET_S = 60.0  # per run
-WINDOWS = ("leading", "scene")
+WINDOWS = ("leading", "whole")
 NOT_ENGINES = ("reference", "linear")  # the default engines are every other one
 MESSAGE_CHARS = 300
 
@@ -163,7 +163,7 @@ def score(traj: Trajectory, case: ScaleCase, criteria: FidelityCriteria) -> dict
         "impacts": len(traj.impacts),
         "leading_matched": matched,
         "match_fraction": matched / case.leading.n if case.leading.n else None,
-        "first_mismatch": m.divergence_reason if m.divergence_kind != "attitude" else None,
+        "first_mismatch": m.match.reason if m.match is not None else None,
         "first_divergence_time_scaled": None
         if m.first_divergence_time is None
         else m.first_divergence_time / case.eps,
@@ -217,7 +217,7 @@ def engine_row(
     `measured`: (steps, wall time) of this engine and dt at the smaller scales already
     run; `blocked`: the reason a smaller scale of this engine and dt was not run (this
     one, costlier, is skipped with it)."""
-    t_run = run_end(case.leading, case.scene.run.t_end, dt, window)
+    t_run = run_end(case.leading, case.reference.t_final, case.scene.run.t_end, dt, window)
     row = _base_row(engine, dt, case, t_run)
     if case.leading.n == 0:
         row["note"] = "not assessed: the reference has no leading impact at this scale"
@@ -373,7 +373,11 @@ def _fits(stars: list[dict], engines: list[str]) -> list[dict]:
     for engine in engines:
         mine = [s for s in stars if s["engine"] == engine and s["dt"] is not None]
         used = [s for s in mine if s["bound"] == "bracket"]
-        fit = power_law_fit([s["dt"] for s in used], [s["alpha_star"] for s in used])
+        fit = power_law_fit(
+            [s["dt"] for s in used],
+            [s["alpha_star"] for s in used],
+            [s["alpha_first_fail"] for s in used],
+        )
         fit["dts_used"] = [s["dt"] for s in used]
         fit["dts_left_out"] = {f"{s['dt']:g}": s["bound"] for s in mine if s["bound"] != "bracket"}
         out.append({"engine": engine, **fit})

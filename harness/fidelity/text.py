@@ -26,13 +26,17 @@ def alpha_star_text(star: dict[str, Any]) -> str:
 
 
 def fit_text(fit: dict[str, Any]) -> str:
-    """'2.01 ± 0.05 (3 dts)', '2.0 (2 dts, no error)' or '-' with fewer than 2 points."""
+    """'2.00 ± 0.05, grid 1.75..2.25 (3 dts)'; without a standard error with 2 dts; '-'
+    with fewer."""
     if fit["k"] is None:
         return "-"
-    n = fit["n_points"]
-    if fit["k_stderr"] is None:
-        return f"{fit['k']:.2f} ({n} dts, no error)"
-    return f"{fit['k']:.2f} ± {fit['k_stderr']:.2f} ({n} dts)"
+    text = f"{fit['k']:.2f}"
+    if fit["k_stderr"] is not None:
+        text += f" ± {fit['k_stderr']:.2f}"
+    if fit.get("k_grid"):
+        lo, hi = fit["k_grid"]
+        text += f", grid {lo:.2f}..{hi:.2f}"
+    return text + f" ({fit['n_points']} dts)"
 
 
 def dt_label(dt: float | None) -> str:
@@ -63,7 +67,7 @@ def header_lines(doc: dict[str, Any]) -> list[str]:
     window = (
         "engines run just past the leading impacts"
         if doc["window"] == "leading"
-        else "engines run to the scaled scene's end"
+        else "engines run to the reference's end (the whole motion)"
     )
     return [
         f"fidelity on {doc['scene']}: {doc['scaling']}; {len(refs)} scales, alpha "
@@ -91,7 +95,7 @@ def exponent_line(doc: dict[str, Any]) -> str:
     if judged:
         return text + f"{judged} engine runs had a c and were judged on it too"
     why = (
-        "engines stop after the leading impacts (--window scene runs them to the end)"
+        "engines stop after the leading impacts; --window whole runs them to the end"
         if doc["window"] == "leading"
         else "no engine run followed the reference to its singularity"
     )
@@ -108,8 +112,9 @@ def _alpha_star_table(doc: dict[str, Any]) -> str:
         rows.append([engine, *cells, fit_text(fits[engine]) if engine in fits else "-"])
     header = ["engine", *[dt_label(d) for d in dts], "k of alpha* ~ dt^k"]
     return (
-        "alpha* (smallest inclination passed; '<=': passes at every scale run, "
-        "'>': fails at the largest)\n" + table(rows, header, "l" + "r" * (len(header) - 1))
+        "alpha* (smallest inclination passed; '<=': passes at every scale run, '>': fails at "
+        "the largest);\nk ± its standard error, and the range the grid's brackets allow for k\n"
+        + table(rows, header, "l" + "r" * (len(header) - 1))
     )
 
 

@@ -61,6 +61,8 @@ def detect_kind(doc: Any) -> str | None:
         return doc["kind"]
     if str(doc.get("command", "")).startswith("sweep"):
         return "sweep"
+    if "alpha_star" in doc and "runs" in doc:
+        return "fidelity"
     if "truth" in doc and "results" in doc:
         return "bench"
     if "cases" in doc and "thresholds" in doc:

@@ -19,7 +19,8 @@ h2 { font-size: 1.3em; margin-top: 2em; border-bottom: 1px solid #bbb; }
 h3 { font-size: 1.1em; margin-top: 1.5em; }
 table { border-collapse: collapse; margin: .8em 0; font-size: .85em; }
 caption { text-align: left; font-weight: 600; padding: .3em 0; }
-th, td { border: 1px solid #ccc; padding: .25em .5em; text-align: right; vertical-align: top; }
+th, td { border: 1px solid #ccc; padding: .25em .5em; text-align: right; vertical-align: top;
+         white-space: nowrap; }
 th { background: #f0f0f0; }
 td.l, th.l { text-align: left; }
 td.pass { background: #d9f2d9; } td.fail { background: #f7d4d4; }

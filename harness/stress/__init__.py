@@ -44,6 +44,7 @@ from typing import Any
 from reference.scene import SceneError
 from reference.trajectory import Trajectory
 
+from ..progress import progress_bar
 from ..simulators import DEFAULT_DT, check_engine, engine_names, is_fixed_step, run_simulator
 from .budget import (
     HARD_CAP_FACTOR,
@@ -59,6 +60,44 @@ from .text import format_stress, num  # noqa: F401
 
 DEFAULT_BUDGET_S = 30.0  # per run
 SKIPPED = "skipped (budget)"
+
+
+def _case_rows(case, engines, others, dt, budget_s, say, bar) -> list[dict[str, Any]]:
+    """The reference and every other simulator on one case (the stress rows)."""
+    rows: list[dict[str, Any]] = []
+    bar.set_postfix_str(f"{case.name}: reference", refresh=False)
+    ref, ref_wall, ref_pred, ref_skipped = run_reference(case.scene, budget_s)
+    say(
+        f"stress: {case.name}: reference {ref.status.value}, {len(ref.impacts)} impacts, "
+        f"t_final={ref.t_final:.6g} ({ref_wall:.2f} s"
+        + (f", full run predicted {ref_pred:.3g} s: skipped)" if ref_skipped else ")")
+    )
+    bar.update()
+    for engine in ["reference", *others]:
+        if engine == "reference" and "reference" not in engines:
+            continue
+        bar.set_postfix_str(f"{case.name}: {engine}", refresh=False)
+        if engine == "reference" and ref_skipped:
+            note = (
+                f"; ran the first {len(ref.impacts)} impacts (t <= {ref.t_final:.6g}) "
+                "as the basis for the engines"
+            )
+            row = _skipped_row(case, engine, None, ref_pred, over_budget(ref_pred, budget_s) + note)
+        elif engine == "reference":
+            row = assess(ref, ref, case.scene, case.scene.run.t_end, exact=True)
+            row = {"case": case.name, "engine": engine, "dt": None, **row}
+            row["wall_time_s"] = ref_wall
+        else:
+            row = _engine_row(case, engine, dt, ref, ref_skipped, budget_s)
+        rows.append(row)
+        say(
+            f"stress: {case.name}: {engine}: {row['verdict']} ({row['status']}, "
+            f"{num(row['wall_time_s'], '.2f')} s)"
+            f"{': ' + row['reason'] if row['reason'] else ''}"
+        )
+        if engine != "reference":
+            bar.update()
+    return rows
 
 
 def _skipped_row(
@@ -157,36 +196,10 @@ def stress(
     load_before = os.getloadavg()
     start = time.perf_counter()
     rows: list[dict[str, Any]] = []
-    for case in selected:
-        ref, ref_wall, ref_pred, ref_skipped = run_reference(case.scene, budget_s)
-        say(
-            f"stress: {case.name}: reference {ref.status.value}, {len(ref.impacts)} impacts, "
-            f"t_final={ref.t_final:.6g} ({ref_wall:.2f} s"
-            + (f", full run predicted {ref_pred:.3g} s: skipped)" if ref_skipped else ")")
-        )
-        for engine in ["reference"] + [e for e in engines if e != "reference"]:
-            if engine == "reference" and "reference" not in engines:
-                continue
-            if engine == "reference" and ref_skipped:
-                note = (
-                    f"; ran the first {len(ref.impacts)} impacts (t <= {ref.t_final:.6g}) "
-                    "as the basis for the engines"
-                )
-                row = _skipped_row(
-                    case, engine, None, ref_pred, over_budget(ref_pred, budget_s) + note
-                )
-            elif engine == "reference":
-                row = assess(ref, ref, case.scene, case.scene.run.t_end, exact=True)
-                row = {"case": case.name, "engine": engine, "dt": None, **row}
-                row["wall_time_s"] = ref_wall
-            else:
-                row = _engine_row(case, engine, dt, ref, ref_skipped, budget_s)
-            rows.append(row)
-            say(
-                f"stress: {case.name}: {engine}: {row['verdict']} ({row['status']}, "
-                f"{num(row['wall_time_s'], '.2f')} s)"
-                f"{': ' + row['reason'] if row['reason'] else ''}"
-            )
+    others = [e for e in engines if e != "reference"]
+    with progress_bar(len(selected) * (1 + len(others)), "stress", unit="run") as bar:
+        for case in selected:
+            rows += _case_rows(case, engines, others, dt, budget_s, say, bar)
     return {
         "cases": rows,
         "dt": dt,
