@@ -8,7 +8,7 @@ STAMP  := $(VENV)/.installed
 AOT    := $(VENV)/.aot
 CORE   := $(wildcard reference/core/*.py)
 
-.PHONY: setup demo test test-slow lint bench figures clean
+.PHONY: setup demo test test-slow lint bench figures browser clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), sys.version' || { echo "need Python >= 3.11 (make PYTHON=/path/to/python3.11)"; exit 2; }
@@ -43,6 +43,11 @@ bench: $(STAMP) $(AOT)
 
 figures: $(STAMP)
 	$(BIN)/harness figures --out out/figures
+
+# Headless Chromium, which tests/test_report.py uses to open a report the way a person
+# does (the test is skipped without it).  Debian/Ubuntu package, installed as root.
+browser:
+	@command -v chromium >/dev/null 2>&1 || { apt-get update && apt-get install -y chromium; }
 
 clean:
 	rm -rf $(VENV) .pytest_cache .ruff_cache reference/core/_aot*

@@ -56,62 +56,40 @@ def write_trajectory_parquet(traj: Trajectory, path: str | Path) -> Path:
 TABLE_SUFFIXES = (".csv", ".parquet")
 
 
-def check_output_path(path: str | Path, suffixes: tuple[str, ...], force: bool = False) -> Path:
-    """The path an output may be written to: a name ending in one of `suffixes`, not an
-    existing file unless `force`, never an existing directory.  Raises ValueError (bad
-    input) otherwise; meant to be called before any work is done."""
+def check_table_path(path: str | Path, force: bool = False) -> Path:
+    """The path a table may be written to: a `.csv` or `.parquet` name, not an existing
+    file unless `force`.  Raises ValueError (bad input) otherwise; meant to be called
+    before any work is done."""
     p = Path(path)
-    if p.suffix.lower() not in suffixes:
-        raise ValueError(f"{p}: the file name must end in {' or '.join(suffixes)}")
-    if p.exists() and not p.is_file():
-        raise ValueError(f"{p} exists and is not a file")
+    if p.suffix.lower() not in TABLE_SUFFIXES:
+        raise ValueError(f"{p}: the file name must end in .csv or .parquet")
     if p.exists() and not force:
         raise ValueError(f"{p} exists; pass --force to replace it")
+    if p.exists() and not p.is_file():
+        raise ValueError(f"{p} exists and is not a file")
     return p
 
 
-def check_table_path(path: str | Path, force: bool = False) -> Path:
-    """`check_output_path` for a table: a `.csv` or `.parquet` name."""
-    return check_output_path(path, TABLE_SUFFIXES, force)
-
-
-def write_atomic(path: Path, write, force: bool = False) -> Path:
-    """Call `write(tmp_path)` on a temporary file in the same folder, then rename it
-    over `path` (os.replace), so a reader never sees a half-written file and an
-    interrupted write leaves the old one.  An existing file is replaced only with
-    `force` (also when it appeared while we wrote)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+def write_table(table: pa.Table, path: str | Path, force: bool = False) -> Path:
+    """Write `table` as CSV or Parquet (by suffix) atomically: into a temporary file in
+    the same folder, then renamed over the name (os.replace), so a reader never sees a
+    half-written file and an interrupted write leaves the old one.  An existing file is
+    replaced only with `force` (`check_table_path`)."""
+    p = check_table_path(path, force)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
     os.close(fd)
     try:
-        write(tmp)
-        if path.exists() and not force:
-            raise ValueError(f"{path} exists; pass --force to replace it")
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
-
-
-def write_table(table: pa.Table, path: str | Path, force: bool = False) -> Path:
-    """Write `table` as CSV or Parquet (by suffix) atomically (`write_atomic`); an
-    existing file is replaced only with `force` (`check_table_path`)."""
-    p = check_table_path(path, force)
-
-    def write(tmp: str) -> None:
         if p.suffix.lower() == ".csv":
             import pyarrow.csv as pcsv
 
             pcsv.write_csv(table, tmp)
         else:
             pq.write_table(table, tmp)
-
-    return write_atomic(p, write, force)
-
-
-def write_text(text: str, path: str | Path, suffixes: tuple[str, ...], force: bool = False) -> Path:
-    """Write `text` (UTF-8) atomically to a `suffixes` file name (`check_output_path`,
-    `write_atomic`)."""
-    p = check_output_path(path, suffixes, force)
-    return write_atomic(p, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), force)
+        if p.exists() and not force:  # appeared while we wrote
+            raise ValueError(f"{p} exists; pass --force to replace it")
+        os.replace(tmp, p)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return p

@@ -79,6 +79,7 @@ def test_alpha_star_is_the_smallest_alpha_passed_before_the_first_failure():
     assert star["alpha_star"] == 1e-1 and star["alpha_first_fail"] == 1e-2
     assert star["bound"] == "bracket"
     assert star["passes_below"] == [1e-3]  # luck after a failure is not fidelity
+    assert (star["alpha_lowest_pass"], star["alpha_below_lowest_pass"]) == (1e-3, 1e-4)
     assert (star["runs"], star["passes"]) == (5, 3)
 
 
@@ -186,6 +187,7 @@ def test_an_engine_that_follows_motions_slower_than_k_steps_has_k_equal_2(resolv
         assert stars[dt]["bound"] == "bracket"
     fit = doc["fits"][0]
     assert fit["k"] == pytest.approx(2.0, abs=1e-3)  # α ∝ ε² up to O(α)
+    assert fit["lowest"]["k"] == pytest.approx(fit["k"])  # monotone: no transition band
     for row in doc["runs"]:
         if row["passes"]:
             assert row["leading_matched"] == row["leading"] == 10

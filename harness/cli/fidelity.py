@@ -67,8 +67,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..fidelity import FidelityCriteria, eps_values, fidelity, format_fidelity
-    from ..io import check_output_path, write_text
     from ..provenance import attach
+    from ..result_files import check_result_path, write_result_text
     from ..simulators import check_engine
     from .common import load_scene_arg
 
@@ -77,7 +77,7 @@ def run(args) -> int:
     try:  # before the runs, not after
         for path, suffix in ((args.out, ".json"), (args.plot, ".png")):
             if path:
-                check_output_path(path, (suffix,), args.force)
+                check_result_path(path, (suffix,), args.force)
     except ValueError as exc:
         raise BadInput(str(exc)) from None
     scene = load_scene_arg(args)
@@ -96,15 +96,15 @@ def run(args) -> int:
     attach(doc, args)
     if args.plot:
         from ..fidelity import alpha_star_figure, save_figure
-        from ..io import write_atomic
+        from ..result_files import write_result_atomic
 
-        path = check_output_path(args.plot, (".png",), args.force)
+        path = check_result_path(args.plot, (".png",), args.force)
         fig = alpha_star_figure(doc)
-        write_atomic(path, lambda tmp: save_figure(fig, tmp), args.force)
+        write_result_atomic(path, lambda tmp: save_figure(fig, tmp), args.force)
         doc["plot"] = str(path)
         note(f"wrote {path}")
     if args.out:
-        write_text(json.dumps(finite(doc), indent=1), args.out, (".json",), args.force)
+        write_result_text(json.dumps(finite(doc), indent=1), args.out, (".json",), args.force)
         note(f"wrote {args.out}")
     emit(doc, args.json, format_fidelity(doc))
     return 0

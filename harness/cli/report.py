@@ -22,19 +22,19 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from ..io import check_output_path, write_text
     from ..provenance import provenance
     from ..report import ReportInputError, build_report, load_inputs
+    from ..result_files import check_result_path, write_result_text
 
     suffixes = (".html", ".htm")
     try:
-        check_output_path(args.out, suffixes, args.force)
+        check_result_path(args.out, suffixes, args.force)
         items = [item for path in args.inputs for item in load_inputs(path)]
     except (ValueError, ReportInputError) as exc:
         raise BadInput(str(exc)) from None
     html = build_report(items, args.out, provenance(getattr(args, "argv", None)))
     try:
-        path = write_text(html, args.out, suffixes, args.force)
+        path = write_result_text(html, args.out, suffixes, args.force)
     except ValueError as exc:
         raise BadInput(str(exc)) from None
     note(f"wrote {path} ({len(html) / 1024:.0f} KiB, {len(items)} result(s))")

@@ -13,7 +13,10 @@
   tells: "bracket" (it passes at α* and fails at the next α of the grid,
   `alpha_first_fail`), "at most" (it passes at every α run: α* ≤ the smallest), "above
   grid" (it fails at the largest α run: α* > it, value null) or "not measured".  Passes
-  below the first failure are listed (`passes_below`): they are luck, not fidelity.
+  below the first failure are listed (`passes_below`): between α* and the smallest α
+  passed (`alpha_lowest_pass`) lies a transition band where passing depends on the exact
+  α (an O(dt) timing error decides whether a close pair of impacts keeps its order), so
+  a finer ε grid can find a failure above a coarse grid's α*.
 - **k** of α* ∝ dt^k: ordinary least squares of log10 α* on log10 dt over the dts
   whose α* is a "bracket" value, with the slope's standard error
   (reference.exponent.ordinary_least_squares); no standard error with fewer than 3
@@ -81,35 +84,36 @@ def exponent_check(
 
 
 def alpha_star(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """α* of one engine at one dt from its rows (module docstring).  Each row has
-    `alpha`, `eps`, `passes` (True / False, None when not run) and `skipped` (None or
-    the reason)."""
+    """α* of one engine at one dt from its rows (module docstring), and the bottom of its
+    transition band: the smallest α it passed at all (`alpha_lowest_pass`) and the next
+    α run below it (`alpha_below_lowest_pass`, failed; None at the grid's bottom).  Each
+    row has `alpha`, `eps`, `passes` (True / False, None when not run) and `skipped`
+    (None or the reason)."""
     ordered = sorted(rows, key=lambda r: -r["alpha"])
+    ran = [r for r in ordered if r.get("passes") is not None]
     star: dict[str, Any] | None = None
     first_fail: dict[str, Any] | None = None
-    skipped = 0
-    for row in ordered:
-        if row.get("skipped") or row.get("passes") is None:
-            skipped += bool(row.get("skipped"))
-            continue
-        if row["passes"]:
-            star = row
-            continue
-        first_fail = row
-        break
-    ran = [r for r in ordered if r.get("passes") is not None]
+    for row in ran:
+        if not row["passes"]:
+            first_fail = row
+            break
+        star = row
+    passed = [r for r in ran if r["passes"]]
+    lowest = passed[-1] if passed else None
+    after = [r for r in ran if lowest is not None and r["alpha"] < lowest["alpha"]]
     below = [] if first_fail is None else [r for r in ran if r["alpha"] < first_fail["alpha"]]
-    out = {
+    return {
         "alpha_star": star["alpha"] if star else None,
         "eps_star": star["eps"] if star else None,
         "alpha_first_fail": first_fail["alpha"] if first_fail else None,
         "bound": _bound(star, first_fail, ran),
+        "alpha_lowest_pass": lowest["alpha"] if lowest else None,
+        "alpha_below_lowest_pass": after[0]["alpha"] if after else None,
         "runs": len(ran),
-        "passes": sum(1 for r in ran if r["passes"]),
-        "skipped": skipped,
+        "passes": len(passed),
+        "skipped": sum(1 for r in ordered if r.get("skipped")),
         "passes_below": [r["alpha"] for r in below if r["passes"]],
     }
-    return out
 
 
 def _bound(star, first_fail, ran) -> str:

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-MARKERS = "osD^v<>ph*"
+MARKERS = "osDPXph*d8"  # no up/down triangles: they mark the grid edges
 
 
 def _plt():
@@ -22,7 +22,9 @@ def _plt():
 
 def alpha_star_figure(doc: dict[str, Any]):
     """log-log α* against dt, one colour per engine: a filled marker at α* where the grid
-    brackets it, with a bar down to the first failing α (the threshold lies on the bar);
+    brackets it, with a bar down to the first failing α (the threshold lies on the bar)
+    and a dotted line on down to the smallest α passed at all (a dash: the transition
+    band, where passing depends on the exact α);
     an open downward triangle at the smallest α where the engine passes at every scale
     (α* at most that), an open upward one at the largest α where it fails at every scale
     (α* above it); the fitted α* = A dt^k dashed, k ± its standard error in the legend.
@@ -51,7 +53,8 @@ def alpha_star_figure(doc: dict[str, Any]):
     ax.set_title(
         f"fidelity limit on '{doc['scene']}': ≥ {crit['match_fraction']:.0%} of "
         f"{crit['leading']} leading impacts matched\n(bar: down to the first failing α; "
-        "▽ passes at every α, △ fails at every α; dotted: the α range tried)",
+        "dotted to a dash: passes again down to there; ▽ passes at every α, △ fails at "
+        "every α;\nhorizontal dotted lines: the α range tried)",
         fontsize=9,
     )
     ax.grid(True, which="major", alpha=0.3)
@@ -79,6 +82,13 @@ def _draw_engine(ax, stars, fit, engine, style) -> None:
         x = s["dt"] * shift
         ax.plot([x, x], [s["alpha_first_fail"], s["alpha_star"]], color=color, lw=1.5)
         ax.plot(x, s["alpha_star"], marker=marker, color=color)
+    for s in stars:  # the transition band: passes again down to the smallest α passed
+        low = s["alpha_lowest_pass"]
+        top = s["alpha_first_fail"] if s["bound"] == "bracket" else None
+        if low is not None and top is not None and low < top:
+            x = s["dt"] * shift
+            ax.plot([x, x], [low, top], color=color, lw=0.8, ls=":")
+            ax.plot(x, low, marker="_", color=color, ms=10)
     for s in stars:
         if s["bound"] == "at most":
             ax.plot(s["dt"] * shift, s["alpha_star"], "v", color=color, mfc="none", ms=9)

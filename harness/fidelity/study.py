@@ -368,7 +368,9 @@ def _alpha_stars(rows: list[dict], plan: list[tuple[str, float | None]]) -> list
 
 
 def _fits(stars: list[dict], engines: list[str]) -> list[dict]:
-    """k of α* ∝ dt^k per engine over its "bracket" values (criteria.power_law_fit)."""
+    """k of α* ∝ dt^k per engine over its "bracket" values (criteria.power_law_fit), and
+    `lowest`: the same for the smallest α passed, over the dts where a failing α lies
+    below it."""
     out = []
     for engine in engines:
         mine = [s for s in stars if s["engine"] == engine and s["dt"] is not None]
@@ -380,6 +382,12 @@ def _fits(stars: list[dict], engines: list[str]) -> list[dict]:
         )
         fit["dts_used"] = [s["dt"] for s in used]
         fit["dts_left_out"] = {f"{s['dt']:g}": s["bound"] for s in mine if s["bound"] != "bracket"}
+        low = [s for s in mine if s["alpha_below_lowest_pass"] is not None]
+        fit["lowest"] = power_law_fit(
+            [s["dt"] for s in low],
+            [s["alpha_lowest_pass"] for s in low],
+            [s["alpha_below_lowest_pass"] for s in low],
+        )
         out.append({"engine": engine, **fit})
     return out
 

@@ -10,6 +10,7 @@ from typing import Any
 from ..text import table
 
 WIDTH = 100
+LADDER_SPACED = 30  # up to this many scales the ladder's characters are spaced
 
 
 def alpha_star_text(star: dict[str, Any]) -> str:
@@ -102,19 +103,39 @@ def exponent_line(doc: dict[str, Any]) -> str:
     return text + f"no engine run has a c ({why}): alpha* rests on the impact criterion alone"
 
 
-def _alpha_star_table(doc: dict[str, Any]) -> str:
+def lowest_pass_text(star: dict[str, Any]) -> str:
+    """The smallest α passed: '1.5e-04'; '<= 2.8e-10' at the grid's bottom; '-' none."""
+    if star["alpha_lowest_pass"] is None:
+        return "-"
+    text = f"{star['alpha_lowest_pass']:.2g}"
+    return text if star["alpha_below_lowest_pass"] is not None else "<= " + text
+
+
+def per_dt_rows(doc: dict[str, Any], cell, fit) -> tuple[list[float | None], list[list[str]]]:
+    """(dts, rows): per engine, `cell(star)` at each dt and `fit(engine's fit)`."""
     dts = sorted({s["dt"] for s in doc["alpha_star"]}, key=lambda d: -(d or math.inf))
     fits = {f["engine"]: f for f in doc["fits"]}
     rows = []
     for engine in doc["engines"]:
         by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
-        cells = [alpha_star_text(by_dt[d]) if d in by_dt else "" for d in dts]
-        rows.append([engine, *cells, fit_text(fits[engine]) if engine in fits else "-"])
+        cells = [cell(by_dt[d]) if d in by_dt else "" for d in dts]
+        rows.append([engine, *cells, fit(fits[engine]) if engine in fits else "-"])
+    return dts, rows
+
+
+def _alpha_star_table(doc: dict[str, Any]) -> str:
+    dts, rows = per_dt_rows(doc, alpha_star_text, fit_text)
     header = ["engine", *[dt_label(d) for d in dts], "k of alpha* ~ dt^k"]
+    _, low = per_dt_rows(doc, lowest_pass_text, lambda f: fit_text(f["lowest"]))
+    low_header = ["engine", *[dt_label(d) for d in dts], "k"]
+    align = "l" + "r" * (len(header) - 1)
     return (
-        "alpha* (smallest inclination passed; '<=': passes at every scale run, '>': fails at "
-        "the largest);\nk ± its standard error, and the range the grid's brackets allow for k\n"
-        + table(rows, header, "l" + "r" * (len(header) - 1))
+        "alpha* (smallest inclination passed with every larger one passed; '<=': passes at "
+        "every scale run,\n'>': fails at the largest); k ± its standard error, and the range "
+        "the grid's brackets allow for k\n"
+        + table(rows, header, align)
+        + "\n\nsmallest inclination passed at all (between it and alpha*, passing depends on "
+        "the exact alpha)\n" + table(low, low_header, align)
     )
 
 
@@ -146,16 +167,17 @@ def _ladder(doc: dict[str, Any]) -> str:
     groups: dict[tuple[str, Any], dict[float, dict]] = {}
     for r in doc["runs"]:
         groups.setdefault((r["engine"], r["dt"]), {})[r["eps"]] = r
+    sep = " " if len(doc["eps"]) <= LADDER_SPACED else ""  # one character per scale
     rows = [
         [
             engine,
             "-" if dt is None else f"{dt:.0e}",
-            " ".join(ladder_char(by_eps.get(e)) for e in doc["eps"]),
+            sep.join(ladder_char(by_eps.get(e)) for e in doc["eps"]),
         ]
         for (engine, dt), by_eps in groups.items()
     ]
     header = ["engine", "dt", f"alpha {refs[0]['alpha']:.1e} -> {refs[-1]['alpha']:.1e}"]
     return (
-        "each scale, largest alpha first: + passes, 0-9 fails (tenths of the leading impacts "
+        "each scale, largest alpha first: + passes, 0-9 fails (tenths of the leading impacts\n"
         "matched), s skipped (budget), . not assessed\n" + table(rows, header, "lll")
     )

@@ -182,7 +182,14 @@ def bench_section(doc: dict[str, Any]) -> str:
 
 def fidelity_section(doc: dict[str, Any]) -> str:
     from ..fidelity import alpha_star_figure, matched_figure
-    from ..fidelity.text import alpha_star_text, dt_label, fit_text, header_lines, ladder_cell
+    from ..fidelity.text import (
+        alpha_star_text,
+        dt_label,
+        fit_text,
+        header_lines,
+        ladder_cell,
+        lowest_pass_text,
+    )
 
     parts = [paragraph(line) for line in header_lines(doc)]
     dts = sorted(
@@ -205,6 +212,20 @@ def fidelity_section(doc: dict[str, Any]) -> str:
             rows,
             "α*: the smallest inclination the engine follows ('<=' passes at every scale run, "
             "'>' fails at the largest)",
+        )
+    )
+    low_rows = []
+    for engine in doc["engines"]:
+        by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
+        low = fits[engine]["lowest"] if engine in fits else None
+        cells = [lowest_pass_text(by_dt[d]) if d in by_dt else "" for d in dts]
+        low_rows.append([engine, *cells, fit_text(low) if low else "-"])
+    parts.append(
+        table(
+            ["engine", *[dt_label(d) for d in dts], "k"],
+            low_rows,
+            "the smallest inclination passed at all: between it and α*, passing depends on "
+            "the exact α (the transition band)",
         )
     )
     parts.append(figure(alpha_star_figure(doc), f"alpha* against dt on {doc['scene']}"))
