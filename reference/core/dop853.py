@@ -16,6 +16,7 @@ from numba import njit
 
 from . import dop853_tableau as tab
 from .clock import two_sum_add
+from .contacts import contact_frame
 from .held import held_rhs
 from .output import push_sample
 from .tolerances import EPS, LOCATE_ITERATIONS, LOCATE_XTOL
@@ -29,9 +30,10 @@ DOP_E5 = np.ascontiguousarray(tab.E5)
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0  # scipy's step control
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 
-INT_DONE, INT_LIFT_OFF, INT_FAILED = 0, 1, 2
-# status; s: where the integration stopped (the chunk's end, or the lift-off); nfev;
-# leaving: index (into the held list) of the contact whose force reached zero
+INT_DONE, INT_LIFT_OFF, INT_FAILED, INT_CROSSING = 0, 1, 2, 3
+# status; s: where the integration stopped (the chunk's end, the lift-off or the
+# crossing); nfev; leaving: index (into the held list) of the contact whose force reached
+# zero
 Integration = namedtuple("Integration", ["status", "s", "nfev", "leaving"])
 
 # `st` in this module is a records.SCRATCH record: stages K (13 rows: 12 stages and
@@ -154,6 +156,53 @@ def locate_lift_off(y, f, h, model, pts, idx, m, work, st, i, lam0, xtol):
 
 
 @njit(cache=True)
+def _lowest_gap(y, model, pts, watch, n_watch):
+    """The smallest gap among contacts watch[:n_watch] at y."""
+    g = math.inf
+    for i in range(n_watch):
+        g = min(g, contact_frame(y, model.flat_ground, pts, watch[i]).gap)
+    return g
+
+
+@njit(cache=True)
+def _gap_at(y, f, sigma, model, pts, idx, m, work, st, watch, n_watch):
+    """The lowest watched gap after one DOP853 step of size σ from (y, f)."""
+    dop853_step(y, f, sigma, model, pts, idx, m, work, st.Ks, st.ys, st.tmp)
+    return _lowest_gap(st.ys, model, pts, watch, n_watch)
+
+
+@njit(cache=True)
+def locate_crossing(y, f, h, g0, model, pts, idx, m, work, st, watch, n_watch, xtol):
+    """σ in (0, h] where the lowest watched gap (g0 > 0 at σ = 0, ≤ 0 at h) reaches zero:
+    Illinois regula falsi with bisection steps on one-step evaluations, as
+    `locate_lift_off`.  Returns (σ, nfev); st.ys holds the state there."""
+    lo, flo, hi = 0.0, g0, h
+    fhi = _gap_at(y, f, h, model, pts, idx, m, work, st, watch, n_watch)
+    nfev = N_STAGES
+    side = 0
+    for it in range(LOCATE_ITERATIONS):
+        if hi - lo <= xtol + 4.0 * EPS * hi:
+            break
+        x = 0.5 * (lo + hi) if it % 3 == 2 or flo == fhi else hi - fhi * (hi - lo) / (fhi - flo)
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+        fx = _gap_at(y, f, x, model, pts, idx, m, work, st, watch, n_watch)
+        nfev += N_STAGES
+        if fx > 0.0:
+            lo, flo = x, fx
+            if side == -1:
+                fhi *= 0.5
+            side = -1
+        else:
+            hi, fhi = x, fx
+            if side == 1:
+                flo *= 0.5
+            side = 1
+    _gap_at(y, f, hi, model, pts, idx, m, work, st, watch, n_watch)
+    return hi, nfev + N_STAGES
+
+
+@njit(cache=True)
 def _grid_samples(
     y, f, t, t_stop, grid, gi, n_grid, model, pts, idx, m, work, st, out, clock, max_samples
 ):
@@ -201,11 +250,14 @@ def integrate_held(
     clock,
     max_samples,
     watch_forces,
+    watch,
+    n_watch,
 ):
     """Integrate the held motion from y (in place) over [0, s_end] with scipy's adaptive
     DOP853; grid samples at the local times grid[:n_grid] (ascending, inside (0, s_end)),
     stamped with clock = (t_hi, t_lo) + the local time.  With watch_forces, stop where a
-    held force reaches zero (INT_LIFT_OFF, y = the state there)."""
+    held force reaches zero (INT_LIFT_OFF, y = the state there); with n_watch > 0, where
+    the lowest gap of contacts watch[:n_watch] reaches zero (INT_CROSSING)."""
     f = st.f
     held_rhs(y, model, pts, idx, m, work, f)
     nfev = 1
@@ -258,6 +310,15 @@ def integrate_held(
                 )  # fmt: skip
                 y[:] = y_new
                 return Integration(INT_LIFT_OFF, t + sigma, nfev + nf + nf2, i)
+        if n_watch > 0:
+            g_new = _lowest_gap(y_new, model, pts, watch, n_watch)
+            if g_new <= 0.0:
+                g0 = _lowest_gap(y, model, pts, watch, n_watch)
+                sigma, nf = locate_crossing(
+                    y, f, h, g0, model, pts, idx, m, work, st, watch, n_watch, LOCATE_XTOL * s_end
+                )
+                y[:] = st.ys
+                return Integration(INT_CROSSING, t + sigma, nfev + nf, -1)
         gi, nf = _grid_samples(
             y, f, t, t_new, grid, gi, n_grid, model, pts, idx, m, work, st, out, clock, max_samples
         )

@@ -19,11 +19,13 @@ from .tolerances import (
 
 @njit(cache=True)
 def chunk_horizon(y, model, gap, rate, accel, noise, held):
-    """Largest safe chunk from the free contacts' jets (held[k]: contact k is held).
-
-    Quadratic lower bound with K = HORIZON_ACC_FACTOR max|g″| + g over the free
-    contacts (a margin on their current second derivatives), and at most
-    LOCAL_TIME_FRACTION of min(√(L/K), ROTATION_TIME_FACTOR a/V)."""
+    """A chunk no free contact should reach the ground within (held[k]: contact k is
+    held): the first root of max(P2, T2) of each free gap, P2 its quadratic lower bound
+    with K = HORIZON_ACC_FACTOR max|g″| + g over the free contacts (a margin on their
+    current second derivatives) and T2 its Taylor quadratic (not a bound: long chunks
+    where the gaps curve away; a crossing it lets through is found after the chunk and
+    located inside it, `phases.contact_step`), and at most LOCAL_TIME_FRACTION of
+    min(√(L/K), ROTATION_TIME_FACTOR a/V)."""
     acc_scale = 0.0
     for k in range(gap.shape[0]):
         if not held[k]:

@@ -31,8 +31,6 @@ from .records import (
 from .search import find_flight_event
 from .tolerances import (
     CONTACT_GAP_RES,
-    LOCATE_ITERATIONS,
-    LOCATE_XTOL,
     MAX_SEARCH_ITERATIONS,
     TINY,
 )
@@ -230,41 +228,21 @@ def _crossed(y, model, pts, cs, gap_res):
 
 
 @njit(cache=True)
-def _min_gap_after(state, model, pts, opts, ws, cs, s, n_crossed, out):
-    """Lowest gap of the crossed contacts after integrating (and projecting) the held
-    motion for s from the chunk's start (ws.y_start); the state into ws.y_chunk."""
+def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
+    """The first time in (0, h] the crossed contacts (cs.together[:n_crossed]) reach the
+    ground: the chunk integrated again from its start watching their gaps, the zero
+    located inside the step that holds it (dop853.locate_crossing); ws.y_chunk ends
+    there, projected.  The horizon's backstop: its Taylor part is not a bound."""
     ws.y_chunk[:] = ws.y_start
     grid = np.empty(0)
     r = integrate_held(
-        ws.y_chunk, s, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
-        ws, ws, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False,
+        ws.y_chunk, h, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
+        ws, ws, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False, cs.together,
+        n_crossed,
     )  # fmt: skip
+    stats.contact_rhs_evals += r.nfev
     project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
-    g = math.inf
-    for i in range(n_crossed):
-        g = min(g, contact_frame(ws.y_chunk, model.flat_ground, pts, cs.together[i]).gap)
-    return g, r.nfev
-
-
-@njit(cache=True)
-def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
-    """The first time in (0, h] the crossed contacts reach the ground (bisection on
-    re-integrations from the chunk's start): the horizon's backstop (it should be rare:
-    the bound makes crossings impossible up to roundoff)."""
-    lo, hi = 0.0, h
-    for _ in range(LOCATE_ITERATIONS):
-        if hi - lo <= LOCATE_XTOL * h + 4.0 * 2.220446049250313e-16 * hi:
-            break
-        mid = 0.5 * (lo + hi)
-        g, nfev = _min_gap_after(state, model, pts, opts, ws, cs, mid, n_crossed, out)
-        stats.contact_rhs_evals += nfev
-        if g > 0.0:
-            lo = mid
-        else:
-            hi = mid
-    g, nfev = _min_gap_after(state, model, pts, opts, ws, cs, hi, n_crossed, out)
-    stats.contact_rhs_evals += nfev
-    return hi
+    return r.s
 
 
 @njit(cache=True)
@@ -298,7 +276,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     ns0 = out.counts[N_SAMPLES]
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
-        ws, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True,
+        ws, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.together, 0,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     if r.status == INT_FAILED:
