@@ -26,6 +26,9 @@ def test_tableau_is_scipys():
     np.testing.assert_array_equal(tab.C, scipy_dop.C[:n])
     np.testing.assert_array_equal(tab.E3, scipy_dop.E3)
     np.testing.assert_array_equal(tab.E5, scipy_dop.E5)
+    np.testing.assert_array_equal(tab.A_EXTRA, scipy_dop.A[n + 1 :])
+    np.testing.assert_array_equal(tab.C_EXTRA, scipy_dop.C[n + 1 :])
+    np.testing.assert_array_equal(tab.D, scipy_dop.D)
 
 
 def _held_state(two: bool):
