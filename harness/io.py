@@ -1,22 +1,60 @@
-"""Files at the edge: Trajectory → Parquet (samples and impacts)."""
+"""Files at the edge: Trajectory → Parquet (samples and impacts); JSON without NaN."""
 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
+from typing import Any
 
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from reference.trajectory import Trajectory
 
+from .outputs import OutputError, atomic_outputs, show
 
-def write_trajectory_parquet(traj: Trajectory, path: str | Path) -> Path:
-    """Samples in FILE, impacts in FILE with `.impacts` before the suffix.
+
+def json_safe(x: Any) -> Any:
+    """JSON has no NaN/inf: map them to null (numpy scalars and arrays to Python)."""
+    import numpy as np
+
+    if isinstance(x, dict):
+        return {k: json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_safe(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return json_safe(x.tolist())
+    if isinstance(x, (np.floating, np.integer, np.bool_)):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def json_text(doc: Any, indent: int | None = None) -> str:
+    """One strict JSON document (no NaN or Infinity tokens)."""
+    return json.dumps(json_safe(doc), indent=indent, allow_nan=False, default=str)
+
+
+def impacts_path(path: str | Path) -> Path:
+    """The impacts file beside FILE: `.impacts` before the suffix."""
+    path = Path(path)
+    if not path.name or path.name in (".", ".."):
+        raise OutputError(f"{show(path)} names a directory; give a file name")
+    return path.with_name(path.stem + ".impacts" + (path.suffix or ".parquet"))
+
+
+def trajectory_paths(path: str | Path) -> list[Path]:
+    """Both files `write_trajectory_parquet` writes."""
+    return [Path(path), impacts_path(path)]
+
+
+def write_trajectory_parquet(traj: Trajectory, path: str | Path, force: bool = False) -> Path:
+    """Samples in FILE, impacts in FILE with `.impacts` before the suffix, both written
+    atomically (harness.outputs): complete, or not there at all.
 
     Both files carry the run's summary (status, message, ...) as schema metadata."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     cols = {"t": traj.t}
     if traj.t_lo is not None:
         cols["t_lo"] = traj.t_lo
@@ -32,19 +70,19 @@ def write_trajectory_parquet(traj: Trajectory, path: str | Path) -> Path:
     cols["kinetic_energy"] = traj.kinetic_energy
     cols["potential_energy"] = traj.potential_energy
     cols["energy"] = traj.energy
-    meta = {b"summary": json.dumps(traj.summary(with_impacts=False), default=str).encode()}
+    meta = {b"summary": json_text(traj.summary(with_impacts=False)).encode()}
     table = pa.table(cols).replace_schema_metadata(meta)
-    pq.write_table(table, path)
     imp = pa.table(
         {
-            "t": [e.t for e in traj.impacts],
-            "t_lo": [e.t_lo for e in traj.impacts],
+            "t": pa.array([e.t for e in traj.impacts], type=pa.float64()),
+            "t_lo": pa.array([e.t_lo for e in traj.impacts], type=pa.float64()),
             "contact": pa.array([e.contact for e in traj.impacts], type=pa.int64()),
-            "impulse": [e.impulse for e in traj.impacts],
-            "v_normal_pre": [e.v_normal_pre for e in traj.impacts],
-            "v_normal_post": [e.v_normal_post for e in traj.impacts],
+            "impulse": pa.array([e.impulse for e in traj.impacts], type=pa.float64()),
+            "v_normal_pre": pa.array([e.v_normal_pre for e in traj.impacts], type=pa.float64()),
+            "v_normal_post": pa.array([e.v_normal_post for e in traj.impacts], type=pa.float64()),
         }
     ).replace_schema_metadata(meta)
-    ipath = path.with_name(path.stem + ".impacts" + (path.suffix or ".parquet"))
-    pq.write_table(imp, ipath)
-    return path
+    with atomic_outputs(trajectory_paths(path), force) as (samples_tmp, impacts_tmp):
+        pq.write_table(table, samples_tmp)
+        pq.write_table(imp, impacts_tmp)
+    return Path(path)

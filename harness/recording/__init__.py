@@ -24,6 +24,7 @@ Everything temporal is on the duration timeline `sim_time` and sent with
 from __future__ import annotations
 
 import math
+import os
 import re
 import uuid
 from pathlib import Path
@@ -35,6 +36,7 @@ import rerun.blueprint as rrb
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
+from ..outputs import atomic_write
 from .geometry import (
     bump_positions,
     contact_points,
@@ -78,11 +80,11 @@ PALETTE = [
 
 
 def recording_path(path: str | Path) -> Path:
-    """Where to write: a bare file name goes under recordings/; parent folders are created."""
+    """Where to write: a bare file name (no folder, not even ./) goes under recordings/.
+    Folders are created when the recording is written (harness.outputs.atomic_write)."""
     p = Path(path)
-    if p.parent == Path("."):
+    if "/" not in str(path) and os.sep not in str(path):
         p = DEFAULT_FOLDER / p
-    p.parent.mkdir(parents=True, exist_ok=True)
     return p
 
 
@@ -125,6 +127,7 @@ def record_trajectories(
     path: str | Path,
     scene: Scene,
     contact_tolerance: float | None = None,
+    force: bool = False,
 ) -> Path:
     """Write one `.rrd` with the trajectories side by side; the first is the reference
     (its t_singularity, else its last impact, is t_f of the log-log plot).
@@ -146,18 +149,19 @@ def record_trajectories(
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     if not rr.is_enabled(rec):
         raise RuntimeError("rerun logging is disabled (RERUN=off?): no recording written")
-    rec.save(out, default_blueprint=blueprint)
-    try:
-        rec.send_recording_name(f"{scene.name}: {', '.join(names)}")
-        for name, traj in zip(names, trajs, strict=True):
-            _log_simulator(rec, name, traj, scene, colors[name], tol)
-            _log_singularity_values(rec, name, loglog[name], colors[name])
-            _log_info(rec, name, traj, loglog[name], t_f)
-        _log_loglog_plot(rec, names, loglog, colors, bounds)
-        _log_summary(rec, scene, names, trajs, loglog, t_f)
-    finally:
-        rec.flush()
-        rec.disconnect()  # closes the file sink: footer and manifest are written
+    with atomic_write(out, force) as tmp:
+        rec.save(tmp, default_blueprint=blueprint)
+        try:
+            rec.send_recording_name(f"{scene.name}: {', '.join(names)}")
+            for name, traj in zip(names, trajs, strict=True):
+                _log_simulator(rec, name, traj, scene, colors[name], tol)
+                _log_singularity_values(rec, name, loglog[name], colors[name])
+                _log_info(rec, name, traj, loglog[name], t_f)
+            _log_loglog_plot(rec, names, loglog, colors, bounds)
+            _log_summary(rec, scene, names, trajs, loglog, t_f)
+        finally:
+            rec.flush()
+            rec.disconnect()  # closes the file sink: footer and manifest are written
     return out
 
 
