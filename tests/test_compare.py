@@ -57,7 +57,7 @@ def calls(monkeypatch):
     """Replace the simulators: record every call; 'pybullet' raises."""
     made: list[tuple[str, float | None]] = []
 
-    def fake(engine, scene, dt=None, t_end=None):
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
         made.append((engine, dt))
         if engine == "pybullet":
             raise RuntimeError("engine exploded")
@@ -98,7 +98,7 @@ def test_a_failing_engine_is_a_failed_row_not_a_crash(calls):
 
 
 def test_bad_input_still_stops_the_command(monkeypatch):
-    def bad(engine, scene, dt=None, t_end=None):
+    def bad(engine, scene, dt=None, t_end=None, **_limits):
         raise SceneError("--dt must be > 0")
 
     monkeypatch.setattr(C, "run_simulator", bad)

@@ -2,29 +2,65 @@
 
 from __future__ import annotations
 
-from .common import emit, load_scene_arg, log, positive_float
+from .common import (
+    add_dt,
+    add_engine,
+    add_force,
+    add_json,
+    add_max_steps,
+    add_scale,
+    add_scene,
+    add_t_end,
+    emit,
+    load_scene_arg,
+    log,
+    scene_inputs,
+)
 
 
 def register(sub) -> None:
-    c = sub.add_parser("compare", help="reference against the named simulators")
-    c.add_argument("scene")
-    c.add_argument("--engine", action="append", required=True)
-    c.add_argument("--dt", type=positive_float, action="append")
-    c.add_argument("--t-end", type=positive_float)
-    c.add_argument("--scale", type=positive_float)
-    c.add_argument("--record", metavar="FILE.rrd")
-    c.add_argument("--json", action="store_true")
+    c = sub.add_parser(
+        "compare",
+        help="reference against the named simulators",
+        description="The exact reference against the named simulators on one scene: "
+        "impacts matched, impact-time, energy and attitude errors.  Ctrl-C stops it "
+        "(exit status 130).",
+    )
+    add_scene(c)
+    add_engine(c, many="at least one", required=True)
+    add_dt(c, many="default: 1e-4")
+    add_t_end(c)
+    add_scale(c)
+    add_max_steps(c)
+    c.add_argument(
+        "--record",
+        metavar="FILE.rrd",
+        help="also write a rerun recording of all runs (a bare file name goes under recordings/)",
+    )
+    add_force(c)
+    add_json(c)
     c.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..compare import compare, format_compare
-    from ..simulators import check_engine
+    from ..outputs import check_writable
+    from ..simulators import check_engine, check_run
 
     for e in args.engine:
         check_engine(e)
     scene = load_scene_arg(args)
-    result = compare(scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log)
+    for e in args.engine:
+        for dt in args.dt or [None]:
+            check_run(e, scene, dt, args.t_end, args.max_steps)
+    check_run("reference", scene, None, args.t_end)
+    if args.record:
+        from ..recording import recording_path
+
+        check_writable(recording_path(args.record), args.force, scene_inputs(args))
+    result = compare(
+        scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log, max_steps=args.max_steps
+    )
     if args.record:
         from ..recording import record_trajectories
 
@@ -32,7 +68,9 @@ def run(args) -> int:
         skipped = len(result.runs) - len(runs)
         if skipped:
             log(f"recording leaves out {skipped} run(s) that produced no samples")
-        path = record_trajectories([result.reference, *runs], args.record, scene=scene)
+        path = record_trajectories(
+            [result.reference, *runs], args.record, scene=scene, force=args.force
+        )
         log(f"wrote {path}")
     emit(result.to_dict(), args.json, format_compare(result))
     return 0
