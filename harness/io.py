@@ -7,9 +7,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-import pyarrow as pa
-import pyarrow.parquet as pq
-
 from reference.trajectory import Trajectory
 
 from .outputs import OutputError, atomic_outputs, show
@@ -55,6 +52,9 @@ def write_trajectory_parquet(traj: Trajectory, path: str | Path, force: bool = F
     atomically (harness.outputs): complete, or not there at all.
 
     Both files carry the run's summary (status, message, ...) as schema metadata."""
+    import pyarrow as pa  # here: the CLI imports this module for json_text alone
+    import pyarrow.parquet as pq
+
     cols = {"t": traj.t}
     if traj.t_lo is not None:
         cols["t_lo"] = traj.t_lo

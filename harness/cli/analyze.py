@@ -18,8 +18,7 @@ ANALYSES = {
 
 
 def register(sub) -> None:
-    from reference.linear.chatter import CHATTER_LEGEND
-    from reference.linear.selfsimilar import SELFSIMILAR_LEGEND
+    from reference.linear._text import CHATTER_LEGEND, SELFSIMILAR_LEGEND
 
     legends = {"selfsimilar": SELFSIMILAR_LEGEND, "chatter": CHATTER_LEGEND}
     a = sub.add_parser("analyze", help="analyses of the linearised model")

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ._text import table
+from ._text import CHATTER_LEGEND, table
 from .model import LinearModel
 
 
@@ -214,21 +214,6 @@ def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
                 pick["c_lin"],
             )
     return doc
-
-
-CHATTER_LEGEND = """\
-output:
-  eigenvalues of R^-1 U0  the map of the velocities p over one impact at vertex 0 and the
-                          rotation to the next vertex, without gravity
-  CC                      complete chatter: the dominant eigenvalue is real and positive
-  PCC                     partial complete chatter: U0 U1 has only real eigenvalues
-  rod (n = 2)             psi = (1 - rho^2)/(1 + rho^2) against the thresholds of complete
-                          chatter without gravity and with gravity
-table (gravity-free self-similar chatter, one row per pair of eigenvalues):
-  beta_p, beta_q          factors per impact: p_i = beta_p^i R^i p0, q_i = beta_q^i R^i q0
-  c_lin                   energy exponent of E ~ (t_f - t)^c_lin: 2 log beta_p / log(beta_q/beta_p)
-  feasible                no contact below the ground, the next vertex reached approaching
-  spectral radius         largest |eigenvalue| of the reduced map's Jacobian (< 1: stable)"""
 
 
 def format_chatter(doc: dict) -> str:

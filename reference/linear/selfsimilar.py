@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import Polynomial as P
 
-from ._text import table
+from ._text import SELFSIMILAR_LEGEND, table
 from .kernel import first_hit
 from .model import LinearModel
 
@@ -376,22 +376,6 @@ def analyze_selfsimilar(n: int, rho: float, gamma: float, gravity: float = 1.0) 
         "polynomial_degree": int(N.degree()),
         "solutions": [s.to_dict() for s in sols],
     }
-
-
-SELFSIMILAR_LEGEND = """\
-columns:
-  beta             factor per impact: p scales by beta and q by beta^2 from one vertex to the
-                   next (0 < beta < 1: the motion runs into the singularity)
-  kind             trivial: tau0 = 0, q0 = 0, p0 an eigenvector of R^-1 U0 for eigenvalue beta;
-                   blank: nontrivial, a root of N(beta) with tau0 > 0
-  feasible         yes: every condition of the paper's section 3.2 holds; marginal: a trivial
-                   solution on their border (tau0 = 0); no: see failed checks
-  stable           the fixed point of the reduced map C-bar is asymptotically stable
-  spectral radius  largest |eigenvalue| of C-bar's Jacobian there (< 1: stable; -: not computed)
-  tau0             duration of the smooth phase between two impacts, with |p0| = 1
-  failed checks    approaching (vertex 0 moves down), tau_positive, non_penetration (no contact
-                   below the ground before tau0), beta_in_0_1, held_vertex_released (gamma = 0:
-                   the held vertex n-1 is not pushed into the ground)"""
 
 
 def format_selfsimilar(doc: dict) -> str:
