@@ -14,8 +14,9 @@ from reference.scene import Scene
 from reference.trajectory import Trajectory
 
 # Largest polygon the engines and the linear model take.  Engines: one contact sphere per
-# vertex; at n = 1e5 MuJoCo needs 23 s to build its model and PyBullet 27 s per step
-# (measured), at 1e4 both run.  Linear model: O(n^2) memory, 0.93 GB at n = 1e4.
+# vertex; at n = 1e5 MuJoCo needs 18 s for its first ten steps (building the model) and
+# PyBullet 136 s for two (measured); at 1e4 both run (0.8 s and 3.2 s for 100 steps).
+# Linear model: O(n^2) memory, 0.93 GB at n = 1e4.
 MAX_VERTICES = 10_000
 
 

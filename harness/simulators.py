@@ -27,7 +27,7 @@ from reference.trajectory import Trajectory
 GROUP = "harness.engines"
 DEFAULT_DT = 1e-4
 # Steps a fixed-step run may take unless --max-steps says otherwise: MuJoCo keeps about
-# 0.6 kB per step (691 MB measured for 1e6 steps), so 1e7 steps stay within ~6 GB.
+# 0.6 kB per step (696 MB measured for 1e6 steps), so 1e7 steps stay within ~6 GB.
 DEFAULT_MAX_STEPS = 10_000_000
 # Listed first, in this order, when installed; everything else follows by name.
 _FIRST = ("reference", "linear")
