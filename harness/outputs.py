@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import stat
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -95,8 +96,9 @@ def atomic_outputs(paths: Sequence[str | os.PathLike], force: bool = False) -> I
             fd, name = tempfile.mkstemp(
                 dir=target.parent, prefix=TEMP_PREFIX, suffix=target.suffix or None
             )
-            os.close(fd)
             tmps.append(Path(name))
+            os.fchmod(fd, _mode_for(target))  # mkstemp makes it private (0600)
+            os.close(fd)
         yield list(tmps)
         for tmp, target in zip(tmps, targets, strict=True):
             _commit(tmp, target, force)
@@ -161,6 +163,17 @@ def _check_names(p: Path, what: str) -> None:
             )
     if len(os.fsencode(os.path.abspath(p))) >= path_max:
         raise OutputError(f"{what} {show(p)} is longer than the {path_max} bytes allowed")
+
+
+def _mode_for(target: Path) -> int:
+    """Permissions of the file to write: those of the file it replaces, else what a
+    plain open() would give (0666 less the umask)."""
+    try:
+        return stat.S_IMODE(os.stat(target).st_mode)
+    except OSError:
+        mask = os.umask(0)
+        os.umask(mask)
+        return 0o666 & ~mask
 
 
 def _existing_ancestor(folder: Path) -> Path:

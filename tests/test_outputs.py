@@ -105,6 +105,22 @@ def test_a_file_that_appears_meanwhile_is_not_replaced_without_force(tmp_path):
     assert target.read_text() == "someone else's" and listing(tmp_path) == ["out.json"]
 
 
+def test_written_files_get_the_usual_permissions_or_keep_the_replaced_ones(tmp_path):
+    mask = os.umask(0o022)
+    try:
+        with atomic_write(tmp_path / "new.json") as tmp:
+            tmp.write_text("x")
+        old = tmp_path / "old.json"
+        old.write_text("old")
+        old.chmod(0o640)
+        with atomic_write(old, force=True) as tmp:
+            tmp.write_text("new")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "new.json").stat().st_mode & 0o777 == 0o644
+    assert old.stat().st_mode & 0o777 == 0o640 and old.read_text() == "new"
+
+
 def test_all_outputs_are_moved_into_place_with_their_suffixes(tmp_path):
     paths = [tmp_path / "a.parquet", tmp_path / "sub" / "a.impacts.parquet"]
     with atomic_outputs(paths) as tmps:
