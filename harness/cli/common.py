@@ -12,6 +12,7 @@ import argparse
 import math
 import re
 import sys
+import textwrap
 import time
 from typing import Any
 
@@ -32,7 +33,8 @@ class BadInput(Exception):
 
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter):
-    """Options' help with their default appended (when there is a meaningful one)."""
+    """Options' help with their default appended (when there is a meaningful one);
+    description and epilog printed as given (Parser wraps the description)."""
 
     def _get_help_string(self, action: argparse.Action) -> str:
         text = action.help or ""
@@ -40,7 +42,7 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
         if (
             "%(default)" not in text
             and action.option_strings
-            and default not in (None, False, argparse.SUPPRESS)
+            and not any(default is x for x in (None, False, argparse.SUPPRESS))
             and not isinstance(default, list)
         ):
             text += " (default: %(default)s)"
@@ -50,6 +52,8 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter):
 class Parser(argparse.ArgumentParser):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         kwargs.setdefault("formatter_class", HelpFormatter)
+        if kwargs.get("description"):  # wrapped here: the epilog (legends) stays as written
+            kwargs["description"] = textwrap.fill(" ".join(kwargs["description"].split()), 88)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
 
