@@ -5,7 +5,8 @@ destroy"):
 
 - `check_writable` runs before the simulation: an output may not be one of the
   command's inputs (not even with --force); an existing file is replaced only with
-  --force, a directory never; and the place must be writable, which is tested by
+  --force, a directory or a device (/dev/null, a pipe) never; and the place must be
+  writable, which is tested by
   creating and removing a temporary file (or directory) in the nearest existing folder,
   so /proc, a read-only mount, a regular file used as a folder or a name longer than the
   file system allows fail at once, with one line, instead of after the run.
@@ -52,6 +53,8 @@ def check_writable(
     if os.path.lexists(p):
         if p.is_dir():
             raise OutputError(f"{what} {show(p)} is a directory; give a file name")
+        if os.path.exists(p) and not p.is_file():
+            raise OutputError(f"{what} {show(p)} is not a regular file (a device, a pipe, ...)")
         if not force:
             raise OutputError(f"{what} {show(p)} exists; use --force to replace it")
     _check_names(p, what)
@@ -217,6 +220,8 @@ def _make_folders(folder: Path) -> list[Path]:
 
 def _commit(tmp: Path, target: Path, force: bool) -> None:
     if force:
+        if os.path.exists(target) and not target.is_file():  # never replace a device
+            raise OutputError(f"{show(target)} is not a regular file")
         os.replace(tmp, target)
         return
     try:

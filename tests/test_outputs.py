@@ -44,6 +44,8 @@ def test_an_existing_file_needs_force_and_a_directory_is_never_a_file(tmp_path):
     assert check_writable(out, force=True) == out
     with pytest.raises(OutputError, match="is a directory"):
         check_writable(tmp_path, force=True)
+    with pytest.raises(OutputError, match="not a regular file"):
+        check_writable("/dev/null", force=True)
     assert out.read_text() == "old"
 
 
