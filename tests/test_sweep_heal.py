@@ -127,3 +127,22 @@ def test_a_directory_that_is_no_sweep_is_refused(tmp_path, foreign):
         sweep(tmp_path)
     assert (tmp_path / foreign).read_text() == "mine"
     assert not (tmp_path / "linear" / "manifest.json").exists()
+
+
+@pytest.mark.parametrize("address", ["closed", "ucx://host:8786", "tcp://[::1", "tcp://:8786"])
+def test_a_bad_scheduler_is_one_line_before_anything_is_written(tmp_path, capsys, address):
+    import socket
+
+    from harness.cli import main
+
+    if address == "closed":  # a port that was free a moment ago: nobody listens
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
+    argv = ["sweep", "exponent", "--gyration", "0.3", "--restitution", "0.5", "--samples", "1"]
+    code = main(
+        [*argv, "--out", str(tmp_path / "sw"), "--executor", "dask", "--scheduler", address]
+    )
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert code == 2 and len(err) == 1 and "scheduler" in err[0].lower()
+    assert not (tmp_path / "sw").exists()

@@ -25,7 +25,7 @@ from pathlib import Path
 from reference.scene import SceneError
 
 from ..simulators import check_engine, check_run, is_fixed_step
-from .executors import ExecutorError
+from .executors import ExecutorError, check_scheduler
 from .grid import (
     SweepConfig,
     all_keys,
@@ -97,6 +97,11 @@ def run_exponent_sweep(args, progress=None) -> dict:
     workers = getattr(args, "workers", None)
     if executor == "dask" and not scheduler:
         raise _bad("--executor dask needs --scheduler ADDR (e.g. tcp://127.0.0.1:8786)")
+    if executor == "dask":
+        try:
+            check_scheduler(scheduler)
+        except ExecutorError as exc:
+            raise _bad(str(exc)) from None
     if workers is not None and workers < 1:
         raise _bad(f"--workers must be >= 1, got {workers}")
     chunk_size = getattr(args, "chunk_size", None)  # optional flag (not in cli.py yet)
