@@ -41,7 +41,7 @@ from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
 from ..metrics import evaluate
-from ..simulators import check_engine, engine_names, is_fixed_step, run_simulator
+from ..simulators import check_engine, check_run, engine_names, is_fixed_step, run_simulator
 from ..text import table
 
 DEFAULT_DTS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6)
@@ -227,29 +227,7 @@ def bench(
             timed(setting, scene, horizon)  # warm-up (e.g. numba compilation)
             measure(setting)
         else:
-            timed(Setting(engine, dt=dts[0]), scene, horizon)  # warm-up
-            measured: list[tuple[float, float]] = []
-            for i, dt in enumerate(dts):
-                setting = Setting(engine, dt=dt)
-                if measured:
-                    predicted = predict_time(measured, dt)
-                    if repeats * predicted > budget_s:
-                        for dt_skip in dts[i:]:
-                            p = predict_time(measured, dt_skip)
-                            skipped.append(
-                                {
-                                    "engine": engine,
-                                    "setting": f"dt={dt_skip:g}",
-                                    "dt": dt_skip,
-                                    "predicted_wall_time_s": p,
-                                    "reason": f"predicted {repeats} x {p:.3g} s > budget "
-                                    f"{budget_s:g} s",
-                                }
-                            )
-                            say(f"bench: {engine} dt={dt_skip:g}: skipped ({p:.3g} s predicted)")
-                        break
-                row = measure(setting)
-                measured.append((dt, row["wall_time_s"]))
+            _fixed_step_sweep(engine, scene, dts, horizon, repeats, budget_s, measure, skipped, say)
     if "reference" not in engines:  # the truth setting is always timed
         measure(truth_setting)
 
@@ -287,6 +265,75 @@ def bench(
         doc["plot"] = str(plot_work_precision(doc, plot))
         say(f"bench: wrote {doc['plot']}")
     return doc
+
+
+def _fixed_step_sweep(
+    engine: str,
+    scene: Scene,
+    dts: list[float],
+    horizon: float,
+    repeats: int,
+    budget_s: float,
+    measure: Callable[[Setting], dict[str, Any]],
+    skipped: list[dict[str, Any]],
+    say: Callable[[str], None],
+) -> None:
+    """A fixed-step engine over the timesteps, coarse to fine: one warm-up run, then
+    `measure` each runnable timestep until the predicted cost exceeds the budget (the
+    rest go to `skipped` with their predicted cost)."""
+    runnable = _runnable_dts(engine, scene, dts, horizon, skipped, say)
+    if runnable:
+        timed(Setting(engine, dt=runnable[0]), scene, horizon)  # warm-up
+    measured: list[tuple[float, float]] = []
+    for i, dt in enumerate(runnable):
+        if measured:
+            predicted = predict_time(measured, dt)
+            if repeats * predicted > budget_s:
+                for dt_skip in runnable[i:]:
+                    p = predict_time(measured, dt_skip)
+                    skipped.append(
+                        {
+                            "engine": engine,
+                            "setting": f"dt={dt_skip:g}",
+                            "dt": dt_skip,
+                            "predicted_wall_time_s": p,
+                            "reason": f"predicted {repeats} x {p:.3g} s > budget {budget_s:g} s",
+                        }
+                    )
+                    say(f"bench: {engine} dt={dt_skip:g}: skipped ({p:.3g} s predicted)")
+                break
+        row = measure(Setting(engine, dt=dt))
+        measured.append((dt, row["wall_time_s"]))
+
+
+def _runnable_dts(
+    engine: str,
+    scene: Scene,
+    dts: list[float],
+    horizon: float,
+    skipped: list[dict[str, Any]],
+    say: Callable[[str], None],
+) -> list[float]:
+    """The timesteps the engine can run to `horizon` (harness.simulators.check_run: at
+    most t_end, within the step ceiling); the others go to `skipped` with the reason."""
+    out = []
+    for dt in dts:
+        try:
+            check_run(engine, scene, dt, horizon)
+        except SceneError as exc:
+            skipped.append(
+                {
+                    "engine": engine,
+                    "setting": f"dt={dt:g}",
+                    "dt": dt,
+                    "predicted_wall_time_s": None,
+                    "reason": str(exc),
+                }
+            )
+            say(f"bench: {engine} dt={dt:g}: skipped ({exc})")
+        else:
+            out.append(dt)
+    return out
 
 
 def _ordered(engines: list[str]) -> list[str]:
