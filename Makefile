@@ -24,10 +24,11 @@ $(AOT): $(STAMP) $(CORE)
 setup: $(STAMP) $(AOT)
 
 # Main job: the reference against both tuned engines on the built-in chatter scene,
-# with a rerun recording of all three side by side.
+# with a rerun recording of all three side by side (--force: the demo's own recording is
+# replaced when the demo runs again).
 demo: $(STAMP) $(AOT)
 	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
-		--record recordings/triangle-chatter.rrd
+		--record recordings/triangle-chatter.rrd --force
 
 test: $(STAMP) $(AOT)
 	$(BIN)/python -m pytest
@@ -42,7 +43,7 @@ bench: $(STAMP) $(AOT)
 	$(BIN)/python benchmarks/reference_speed.py
 
 figures: $(STAMP)
-	$(BIN)/harness figures --out out/figures
+	$(BIN)/harness figures --out out/figures --force
 
 # Headless Chromium, which tests/test_report.py uses to open a report the way a person
 # does (the test is skipped without it).  Debian/Ubuntu package, installed as root.

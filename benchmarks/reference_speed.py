@@ -1,25 +1,25 @@
-"""Speed of the exact reference: impacts per second and per-impact cost against n.
+"""Speed of the exact reference against its targets (`make bench`).
 
-    .venv/bin/python benchmarks/reference_speed.py [--repeats 3] [--only NAME ...]
-        [--profile] [--json FILE]
+    .venv/bin/python benchmarks/reference_speed.py [--repeats 5] [--only TEXT ...]
+        [--json FILE] [--no-startup] [--no-sweep]
 
-Each case runs once untimed (warm-up: imports, caches), then `repeats` timed runs;
-reported: median and minimum wall time, impacts, impacts/s and µs/impact from the
-median, with the machine's load average (the machine is shared: read timings with it).
-Targets (issue 6): ≥ 100,000 impacts/s for the triangle (n = 3, flat, γ > 0), and a
-per-impact cost within 2× from n = 10 to n = 10,000; the script prints both ratios.
+Every figure is a median over `repeats` runs in one process after an untimed warm-up
+run (compilation and loading are never timed: `stats.compile_s` says what they cost),
+on one core when the machine lets us pin it, with the load average printed before and
+after.  Printed as one table per target, each row with its target and whether it is met:
 
-Cases: the built-in `triangle-chatter` and `pentagon-bounce` scenes as they are, and a
-family of flat n-gons started from elastic-hexagon's linear state (q = (0.01, −0.004,
-0.03), p = (0.03, 0.05, −0.2), ρ = 0.5) with γ = 1 (elastic: the motion goes on, so the
-cost per impact is a steady rate) and γ = 0.8 (impacts dissipate: chatter, sustained
-contact phases), each to a fixed number of impacts (t_end = 1e6, so the grid sampling
-costs nothing); and the triangle at γ = 0.5, 0.9, 0.99 run to its end (`…-to-end`).
-The per-impact costs of the γ = 0.8 family depend on how often each polygon chatters
-(every chatter is a completion and a contact phase, ~1 ms in Python whatever n): the
-printed counts of completions and contact chunks say how the mixes differ.
-`--profile` prints cProfile's top entries (cumulative and own time) for n = 3 and
-n = 10,000, elastic and γ = 0.8.
+1. runs to their end, impacts/s (stats.impacts_per_s): every built-in scene; generic
+   tumbling scenes (n = 3 … 10,000, γ = 0, 0.5, 1, flat and three-point ground, fast
+   spin); target ≥ 100,000/s, and ≥ 300,000/s for plain bouncing (γ = 1, no contact
+   phase), fast spin included;
+2. event-search iterations per impact on fast-spinning scenes, target ≤ 3;
+3. contact phases: time per phase, all in, and without the integrator's right-hand
+   side evaluations (their count × the measured cost of one), target ≤ 20 µs;
+4. start-up of whole processes against `python -c "import numpy"`: `harness scenes`
+   ≤ 3×, `harness simulate` of a short built-in scene ≤ 6×;
+5. sweeps: the reference against the linear model per run on a subgrid of the paper's
+   exponent map, target ≤ 5×, and the full 21 × 21 × 100 map estimated on 2 cores,
+   target ≤ 5 min.
 
 This is a benchmark, not a test: nothing here asserts a speed.
 """
@@ -27,185 +27,295 @@ This is a benchmark, not a test: nothing here asserts a speed.
 from __future__ import annotations
 
 import argparse
-import cProfile
-import io
 import json
+import math
 import os
-import pstats
 import statistics
+import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # no BLAS threads spinning beside us
 
-from harness.scenes import resolve_scene  # noqa: E402
-from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear  # noqa: E402
-from reference.simulate import simulate  # noqa: E402
-
-Q0 = (0.01, -0.004, 0.03)
-P0 = (0.03, 0.05, -0.2)
+from harness.scenes import builtin_names, resolve_scene  # noqa: E402
+from reference import ReferenceOptions, Scene, simulate  # noqa: E402
+from reference.scene import scene_from_dict  # noqa: E402
 
 
-def polygon(n: int, gamma: float, impacts: int) -> Scene:
-    """Flat n-gon from elastic-hexagon's linear state, run to `impacts` impacts."""
-    return Scene(
-        name=f"n{n}-gamma{gamma:g}",
-        body=Body(n=n, gyration=0.5),
-        ground=Ground(),
-        initial=initial_from_linear(Q0, P0),
-        restitution=gamma,
-        gravity=1.0,
-        run=RunSettings(t_end=1e6, max_impacts=impacts),
+@dataclass
+class Row:
+    case: str
+    impacts: int
+    status: str
+    wall_s: float
+    stats: object
+
+    @property
+    def rate(self) -> float:
+        return self.impacts / self.wall_s if self.wall_s > 0 else math.inf
+
+
+# ----------------------------------------------------------------------------- scenes
+
+
+def tumbling(n: int, gamma: float, ground: str = "flat", rho: float = 0.45) -> Scene:
+    """A tilted polygon dropped with a wobble (linear coordinates), run to its end or to
+    20,000 impacts."""
+    return scene_from_dict(
+        {
+            "name": f"n{n}-g{gamma:g}-{ground}",
+            "restitution": gamma,
+            "body": {"n": n, "gyration": rho},
+            "ground": {"kind": ground, "bump_radius": 0.5},
+            "initial": {"q": [0.012, -0.007, 0.05], "p": [0.2, -0.15, -0.5]},
+            "run": {"t_end": 1e4, "max_impacts": 20_000},
+        }
+    )
+
+
+def fast_spin(n: int, gamma: float, spin: float = 20.0, alpha: float = 0.02) -> Scene:
+    """A polygon tilted by α spinning fast about the vertical, dropped from a little
+    above its lowest vertex."""
+    return scene_from_dict(
+        {
+            "name": f"spin-n{n}-g{gamma:g}",
+            "restitution": gamma,
+            "body": {"n": n, "gyration": 0.5},
+            "initial": {
+                "position": [0.0, 0.0, math.sin(alpha) + 0.01],
+                "rotation_vector": [alpha, 0.0, 0.0],
+                "velocity": [0.0, 0.0, -0.1],
+                "angular_velocity": [0.0, 0.3, spin],
+            },
+            "run": {"t_end": 1e4, "max_impacts": 20_000},
+        }
     )
 
 
 def cases() -> dict[str, Scene]:
-    """Name → scene.  Impact counts keep each run to seconds on this machine."""
-    out = {
-        "triangle-chatter": resolve_scene("triangle-chatter"),
-        "pentagon-bounce": resolve_scene("pentagon-bounce"),
-    }
+    out = {f"builtin {name}": resolve_scene(name) for name in builtin_names()}
     for n in (3, 10, 100, 1000, 10_000):
-        out[f"n{n}-elastic"] = polygon(n, 1.0, 20_000)
-    for n in (3, 10, 100, 1000, 10_000):
-        out[f"n{n}-gamma0.8"] = polygon(n, 0.8, 2000)
-    # the triangle with 0 < γ < 1 run to its end (a γ < 1 run is finite: chatter, then a
-    # simultaneous impact or the singularity), so the rate includes every phase
-    for gamma in (0.5, 0.9, 0.99):
-        out[f"n3-gamma{gamma:g}-to-end"] = polygon(3, gamma, 1_000_000)
+        for gamma in (0.0, 0.5, 1.0):
+            out[f"tumbling n={n} γ={gamma:g} flat"] = tumbling(n, gamma)
+    for n in (3, 25):
+        for gamma in (0.0, 0.5, 1.0):
+            out[f"tumbling n={n} γ={gamma:g} three-point"] = tumbling(n, gamma, "three_point")
+    for n in (3, 7, 16, 100):
+        for gamma in (0.5, 1.0):
+            out[f"fast spin n={n} γ={gamma:g}"] = fast_spin(n, gamma)
     return out
 
 
-def measure(scene: Scene, repeats: int) -> dict:
-    simulate(scene)  # warm-up
-    walls, outside, in_loop, traj = [], [], [], None
-    load = os.getloadavg()[0]
+# ----------------------------------------------------------------------------- timing
+
+
+def measure(name: str, scene: Scene, repeats: int) -> Row:
+    """Median wall time of the run itself (stats.wall_time_s) after a warm-up; a large
+    sample spacing, so the figure is the events' cost (samples at every event remain)."""
+    opts = ReferenceOptions(sample_dt=scene.run.t_end)
+    simulate(scene, options=opts)
+    walls, traj = [], None
+    for _ in range(repeats):
+        traj = simulate(scene, options=opts)
+        walls.append(traj.stats.wall_time_s)
+    return Row(name, len(traj.impacts), traj.status.value, statistics.median(walls), traj.stats)
+
+
+def rhs_cost_s() -> float:
+    """Seconds per right-hand-side evaluation of a held motion (one contact), timed in a
+    compiled loop of a million evaluations."""
+    import numpy as np
+    from numba import njit
+
+    from reference.core.held import held_rhs, new_work
+    from reference.simulate import make_problem
+
+    scene = resolve_scene("polygon25-rolling")
+    p = make_problem(scene, 1.0, ReferenceOptions())
+    work = new_work()
+
+    @njit
+    def loop(y, model, pts, idx, w, n):
+        dy = np.empty(13)
+        acc = 0.0
+        for _ in range(n):
+            y[12] += 1e-12
+            held_rhs(y, model, pts, idx, 1, w, dy)
+            acc += dy[9]
+        return acc
+
+    y = p.state["y"][0].copy()
+    args = (y, p.model[0], p.points, np.array([0, 0, 0]), work[0])
+    loop(*args, 10)
+    t0 = time.perf_counter()
+    loop(*args, 1_000_000)
+    return (time.perf_counter() - t0) / 1_000_000
+
+
+def process_time(cmd: list[str], repeats: int) -> float:
+    """Median wall time of a whole process (after one untimed run)."""
+    subprocess.run(cmd, capture_output=True, check=False)
+    times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        traj = simulate(scene)
-        walls.append(time.perf_counter() - t0)
-        loop_s = traj.stats.get("bounce_loop_s", 0.0)
-        outside.append(traj.stats["wall_time_s"] - loop_s)
-        in_loop.append(loop_s)
-    med = statistics.median(walls)
-    n = len(traj.impacts)
-    return {
-        "scene": scene.name,
-        "n": scene.body.n,
-        "restitution": scene.restitution,
-        "status": traj.status.value,
-        "impacts": n,
-        "t_final": traj.t_final,
-        "wall_median_s": med,
-        "wall_min_s": min(walls),
-        "impacts_per_s": n / med if n else None,
-        "us_per_impact": 1e6 * med / n if n else None,
-        "contact_chunks": traj.stats.get("contact_chunks"),
-        "contact_phases": sum(1 for ph in traj.phases if ph.kind == "contact"),
-        # medians over the timed runs: time outside / inside the compiled flight loop
-        "outside_bounce_loop_s": statistics.median(outside),
-        "bounce_loop_us_per_impact": (
-            1e6 * statistics.median(in_loop) / traj.stats["bounce_loop_impacts"]
-            if traj.stats.get("bounce_loop_impacts")
-            else None
-        ),
-        "chatter_completions": traj.stats.get("chatter_completions"),
-        "load_1min": load,
-    }
+        subprocess.run(cmd, capture_output=True, check=False)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
 
 
-def profile(scene: Scene, top: int = 15) -> str:
-    simulate(scene)  # warm-up
-    prof = cProfile.Profile()
-    prof.enable()
-    traj = simulate(scene)
-    prof.disable()
-    out = io.StringIO()
-    out.write(f"--- cProfile {scene.name}: {len(traj.impacts)} impacts ---\n")
-    for key in ("cumulative", "tottime"):
-        stats = pstats.Stats(prof, stream=out).strip_dirs().sort_stats(key)
-        stats.print_stats(top)
-    return out.getvalue()
+def sweep_ratio(samples: int) -> tuple[float, float, int]:
+    """Mean seconds per run of the reference and the linear model on a 4 × 4 subgrid
+    (ρ, γ from 0.2 to 0.8) of the paper's exponent map, `samples` initial states each."""
+    from harness.sweep.grid import SweepConfig, grid_values, initial_state
+    from harness.sweep.run import run_linear_sample, run_trajectory_sample
+
+    rhos, gammas = grid_values(0.2, 0.8, 4), grid_values(0.2, 0.8, 4)
+    cost = {}
+    for engine, run in (("linear", run_linear_sample), ("reference", run_trajectory_sample)):
+        cfg = SweepConfig(n=3, engine=engine, gyration=(0.2, 0.8, 4),
+                          restitution=(0.2, 0.8, 4), samples=samples, seed=1)  # fmt: skip
+        run(cfg, 0.5, 0.5, *initial_state(1, 0, 0, 0))  # warm-up
+        t0 = time.perf_counter()
+        for i, rho in enumerate(rhos):
+            for j, gamma in enumerate(gammas):
+                for s in range(samples):
+                    run(cfg, rho, gamma, *initial_state(1, j, i, s))
+        cost[engine] = (time.perf_counter() - t0) / (len(rhos) * len(gammas) * samples)
+    return cost["reference"], cost["linear"], len(rhos) * len(gammas) * samples
+
+
+# ----------------------------------------------------------------------------- report
+
+
+def table(rows: list[list[str]], header: list[str]) -> str:
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(header)]
+    lines = ["  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True))]
+    lines.append("  ".join("-" * w for w in widths))
+    lines += ["  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+    return "\n".join(lines)
+
+
+def plain_bouncing(row: Row) -> bool:
+    return row.stats.contact_phases == 0 and row.status in ("max_impacts", "t_end")
+
+
+def rate_rows(rows: list[Row]) -> list[list[str]]:
+    out = []
+    for r in rows:
+        target = 300_000 if plain_bouncing(r) else 100_000
+        out.append([
+            r.case, str(r.impacts), r.status, f"{r.wall_s * 1e3:.2f}", f"{r.rate / 1e3:.0f}k",
+            f"≥ {target // 1000}k", "yes" if r.rate >= target else "NO",
+        ])  # fmt: skip
+    return out
+
+
+def spin_rows(rows: list[Row]) -> list[list[str]]:
+    return [
+        [
+            r.case,
+            f"{r.stats.search_iterations_per_impact:.2f}",
+            "≤ 3",
+            "yes" if r.stats.search_iterations_per_impact <= 3 else "NO",
+        ]  # fmt: skip
+        for r in rows
+        if r.case.startswith("fast spin")
+    ]
+
+
+def contact_rows(rows: list[Row], t_rhs: float) -> list[list[str]]:
+    """Per contact phase: all-in time (the run's wall time less its impacts at the
+    plain-bouncing cost is not attempted: all of it, flights included) and the time left
+    once the integrator's RHS evaluations are taken out."""
+    out = []
+    for r in rows:
+        phases = r.stats.contact_phases
+        if phases < 10:
+            continue
+        all_in = r.wall_s / phases
+        rest = (r.wall_s - r.stats.contact_rhs_evals * t_rhs) / phases
+        out.append([r.case, str(phases), f"{all_in * 1e6:.1f}", f"{rest * 1e6:.1f}", "≤ 20",
+                    "yes" if rest <= 20e-6 else "NO"])  # fmt: skip
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--only", action="append", help="case names (default: all)")
-    ap.add_argument(
-        "--profile", action="store_true", help="cProfile n = 3 and n = 10,000 (both families)"
-    )
-    ap.add_argument("--json", metavar="FILE")
+    ap.add_argument("--repeats", type=int, default=5, help="timed runs per case (default 5)")
+    ap.add_argument("--only", action="append", help="cases whose name contains TEXT")
+    ap.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
+    ap.add_argument("--no-startup", action="store_true", help="skip the start-up timings")
+    ap.add_argument("--no-sweep", action="store_true", help="skip the sweep timing")
     args = ap.parse_args(argv)
-    all_cases = cases()
-    names = args.only or list(all_cases)
-    unknown = [n for n in names if n not in all_cases]
-    if unknown:
-        ap.error(f"unknown case(s) {unknown}; choose from {list(all_cases)}")
+    if hasattr(os, "sched_setaffinity") and len(os.sched_getaffinity(0)) > 1:
+        os.sched_setaffinity(0, {max(os.sched_getaffinity(0))})
+    from reference import compiled
+
     load0 = os.getloadavg()
-    rows = []
-    header = f"{'case':22s} {'status':20s} {'impacts':>8s} {'median[s]':>10s} {'min[s]':>9s}"
-    header += f" {'impacts/s':>10s} {'us/impact':>10s} {'chatter':>7s} {'chunks':>6s} {'load':>5s}"
-    print(header)
-    for name in names:
-        r = measure(all_cases[name], args.repeats)
-        r["case"] = name
-        rows.append(r)
-        print(
-            f"{name:22s} {r['status']:20s} {r['impacts']:8d} {r['wall_median_s']:10.4f} "
-            f"{r['wall_min_s']:9.4f} {r['impacts_per_s'] or 0:10.0f} "
-            f"{r['us_per_impact'] or 0:10.1f} {r['chatter_completions']:7d} "
-            f"{r['contact_chunks']:6d} {r['load_1min']:5.2f}",
-            flush=True,
-        )
-    by = {r["case"]: r for r in rows}
-    ratios = {}
-    for fam in ("elastic", "gamma0.8"):
-        a, b = by.get(f"n10-{fam}"), by.get(f"n10000-{fam}")
-        if a and b and a["us_per_impact"] and b["us_per_impact"]:
-            ratios[fam] = b["us_per_impact"] / a["us_per_impact"]
-            print(f"per-impact cost n=10,000 / n=10 ({fam}): {ratios[fam]:.2f}x (target <= 2)")
-            if fam != "elastic":
-                # split: the compiled flight/impact loop per impact, everything else
-                # (chatter completions, contact phases, events in Python) per contact phase
-                for r in (a, b):
-                    per_phase = r["outside_bounce_loop_s"] / max(r["contact_phases"], 1)
-                    print(
-                        f"  n={r['n']}: compiled loop {r['bounce_loop_us_per_impact'] or 0:.1f} "
-                        f"us/impact; the rest {1e3 * per_phase:.2f} ms per contact phase "
-                        f"({r['contact_phases']} phases, {r['chatter_completions']} chatter "
-                        f"completions in {r['impacts']} impacts)"
-                    )
-    triangles = ["n3-elastic", "n3-gamma0.8", "triangle-chatter"]
-    triangles += [k for k in by if k.startswith("n3-gamma") and k.endswith("-to-end")]
-    for name in triangles:
-        if name in by and by[name]["impacts_per_s"]:
-            ips = by[name]["impacts_per_s"]
-            print(f"{name}: {ips:,.0f} impacts/s = {ips / 1e5:.3g} of the 100,000/s target")
+    warm = compiled.warm_up()
+    print(f"load average {load0[0]:.2f}; compiled core: {compiled.kernel_source()}; "
+          f"compilation/loading before the first run: {warm:.2f} s (not timed)")  # fmt: skip
+    rows = [
+        measure(name, scene, args.repeats)
+        for name, scene in cases().items()
+        if not args.only or any(t in name for t in args.only)
+    ]
+    head = ["run to its end", "impacts", "status", "ms", "impacts/s", "target", "met"]
+    print("\n1. impacts per second\n" + table(rate_rows(rows), head))
+    if spin := spin_rows(rows):
+        print("\n2. search iterations per impact, fast spin\n"
+              + table(spin, ["run", "iterations/impact", "target", "met"]))  # fmt: skip
+    t_rhs = rhs_cost_s()
+    if cont := contact_rows(rows, t_rhs):
+        head = ["run", "phases", "µs/phase", "µs/phase without RHS", "target", "met"]
+        print(f"\n3. contact phases (one RHS evaluation: {t_rhs * 1e9:.0f} ns)\n"
+              + table(cont, head))  # fmt: skip
+    doc = {"load_before": load0, "rows": [r.__dict__ | {"stats": r.stats.to_dict()} for r in rows]}
+    if not args.no_startup:
+        doc["startup"] = startup_report(args.repeats)
+    if not args.no_sweep:
+        doc["sweep"] = sweep_report()
     load1 = os.getloadavg()
-    print(
-        f"load average before {' '.join(f'{x:.2f}' for x in load0)}, after "
-        f"{' '.join(f'{x:.2f}' for x in load1)}; {os.cpu_count()} cpus; "
-        f"median of {args.repeats} after a warm-up"
-    )
-    profiles = []
-    if args.profile:
-        for name in ("n3-elastic", "n3-gamma0.8", "n10000-elastic", "n10000-gamma0.8"):
-            text = profile(all_cases[name])
-            profiles.append(text)
-            print(text)
+    print(f"\nload average before {load0[0]:.2f}, after {load1[0]:.2f}")
     if args.json:
-        doc = {
-            "rows": rows,
-            "per_impact_cost_ratio_n10000_vs_n10": ratios,
-            "load": {"before": load0, "after": load1},
-            "cpu_count": os.cpu_count(),
-            "repeats": args.repeats,
-            "profiles": profiles,
-        }
-        Path(args.json).write_text(json.dumps(doc, indent=1))
+        Path(args.json).write_text(json.dumps(doc, indent=1, default=str))
     return 0
+
+
+def startup_report(repeats: int) -> dict:
+    py = sys.executable
+    harness = str(Path(py).with_name("harness"))
+    numpy_s = process_time([py, "-c", "import numpy"], repeats)
+    scenes_s = process_time([harness, "scenes"], repeats)
+    simulate_s = process_time([harness, "simulate", "grazing-contact"], repeats)
+    rows = [
+        ["python -c 'import numpy'", f"{numpy_s:.3f}", "1.0", "-", "-"],
+        ["harness scenes", f"{scenes_s:.3f}", f"{scenes_s / numpy_s:.1f}", "≤ 3",
+         "yes" if scenes_s <= 3 * numpy_s else "NO"],
+        ["harness simulate grazing-contact", f"{simulate_s:.3f}", f"{simulate_s / numpy_s:.1f}",
+         "≤ 6", "yes" if simulate_s <= 6 * numpy_s else "NO"],
+    ]  # fmt: skip
+    print("\n4. start-up (whole processes, median)\n"
+          + table(rows, ["command", "s", "× numpy", "target", "met"]))  # fmt: skip
+    return {"numpy_s": numpy_s, "scenes_s": scenes_s, "simulate_s": simulate_s}
+
+
+def sweep_report() -> dict:
+    ref, lin, n = sweep_ratio(samples=5)
+    full_s = 21 * 21 * 100 * ref / 2
+    rows = [
+        ["reference / linear per run", f"{ref * 1e3:.2f} / {lin * 1e3:.2f} ms",
+         f"{ref / lin:.1f}×", "≤ 5×", "yes" if ref <= 5 * lin else "NO"],
+        ["full 21 × 21 × 100 map on 2 cores", f"{full_s / 60:.1f} min", "-", "≤ 5 min",
+         "yes" if full_s <= 300 else "NO"],
+    ]  # fmt: skip
+    print(f"\n5. sweeps ({n} runs of a 4 × 4 subgrid, one core)\n"
+          + table(rows, ["figure", "value", "ratio", "target", "met"]))  # fmt: skip
+    return {"reference_s": ref, "linear_s": lin, "full_map_2cores_s": full_s}
 
 
 if __name__ == "__main__":

@@ -30,7 +30,9 @@ and the onset row.
 
 from __future__ import annotations
 
+import contextlib
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -89,6 +91,31 @@ def state_from_kinematics(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndar
     return np.concatenate([data.xpos[bid], data.xquat[bid], vel[3:6], vel[0:3]])
 
 
+# --------------------------------------------------------------------------- warnings
+# At most this many of MuJoCo's warnings are kept per run (the first ones).
+MAX_WARNINGS = 20
+
+
+@contextlib.contextmanager
+def captured_warnings():
+    """Collect MuJoCo's warnings (e.g. "Nan, Inf or huge value in QACC") into a list
+    instead of its default handler, which prints them to stdout (where they would break
+    `--json`) and appends them to MUJOCO_LOG.TXT in the working directory
+    (`mujoco.set_mju_user_warning`; the previous handler is restored on exit)."""
+    caught: list[str] = []
+
+    def keep(message: str) -> None:
+        if len(caught) < MAX_WARNINGS:
+            caught.append(str(message).strip())
+
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(keep)
+    try:
+        yield caught
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
 # --------------------------------------------------------------------------- running
 @dataclass
 class MujocoRun:
@@ -119,10 +146,23 @@ def run_mujoco(
     t_end: float | None = None,
     profile: str = "tuned",
     half_step: bool | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> MujocoRun:
     """Step the scene's MuJoCo model with timestep dt until t_end (scene.run.t_end by
     default) and record every step.  `half_step` overrides the profile's leapfrog reading
-    of velocities (`staggered_start`, `whole_step_velocities`)."""
+    of velocities (`staggered_start`, `whole_step_velocities`).  `progress(done, total)`
+    is called after every chunk of CHUNK_STEPS steps.  Ctrl-C stops the run at the end of
+    the current chunk: status failed, stats["interrupted"], the steps so far kept.
+    MuJoCo's warnings go to stats["mujoco_warnings"] (`captured_warnings`), not to
+    stdout and MUJOCO_LOG.TXT."""
+    with captured_warnings() as warnings:
+        run = _run_mujoco(scene, dt, t_end, profile, half_step, progress)
+    if warnings:
+        run.stats["mujoco_warnings"] = warnings
+    return run
+
+
+def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
     t_wall = time.perf_counter()
     if profile not in ENGINE_NAMES:
         raise ValueError(f"unknown MuJoCo profile {profile!r}; choose tuned or default")
@@ -145,36 +185,47 @@ def run_mujoco(
     status, message = Status.T_END, ""
     stepping = 0.0
     done = 0
-    while done < n_steps:
-        chunk = min(CHUNK_STEPS, n_steps - done)
-        last = done + chunk == n_steps
-        # from state `done`: st[i] = state done + i + 1, sd[i] = sensors at state done + i;
-        # one step more than kept, so the force at the chunk's last state is known
-        t0 = time.perf_counter()
-        st, sd = rollout.rollout(model, data, state[None], nstep=chunk + 1)
-        stepping += time.perf_counter() - t0
-        st, sd = st[0], sd[0][:, 0::3]  # contact-frame force: normal component first
-        ok = _valid_rows(st, done * dt, dt)
-        if ok < chunk + 1:
-            status = Status.FAILED
-            message = f"MuJoCo's state became invalid (NaN or reset) at t = {(done + ok) * dt:.6g}"
-            rows.append(st[:ok])
-            forces.append(sd[:ok])
-            break
-        rows.append(st[:chunk])
-        forces.append(sd[: chunk + 1 if last else chunk])
-        after = st[chunk]
-        done += chunk
-        state = st[chunk - 1].copy()
-        lowest = contact_kinematics(scene, _states(rows[-1], nq, nv))[0].min(axis=1)
-        if lowest.min() < depth_limit:
-            status = Status.FAILED
-            bad = int(np.argmax(lowest < depth_limit))
-            message = f"the body fell through the ground at t = {rows[-1][bad, 0]:.6g}"
-            after = rows[-1][bad + 1] if bad + 1 < len(rows[-1]) else None
-            rows[-1] = rows[-1][: bad + 1]
-            forces[-1] = forces[-1][: bad + 2]
-            break
+    interrupted = False
+    try:
+        while done < n_steps:
+            if progress is not None:
+                progress(done, n_steps)
+            chunk = min(CHUNK_STEPS, n_steps - done)
+            last = done + chunk == n_steps
+            # from state `done`: st[i] = state done + i + 1, sd[i] = sensors at state done + i;
+            # one step more than kept, so the force at the chunk's last state is known
+            t0 = time.perf_counter()
+            st, sd = rollout.rollout(model, data, state[None], nstep=chunk + 1)
+            stepping += time.perf_counter() - t0
+            st, sd = st[0], sd[0][:, 0::3]  # contact-frame force: normal component first
+            ok = _valid_rows(st, done * dt, dt)
+            if ok < chunk + 1:
+                status = Status.FAILED
+                message = (
+                    f"MuJoCo's state became invalid (NaN or reset) at t = {(done + ok) * dt:.6g}"
+                )
+                rows.append(st[:ok])
+                forces.append(sd[:ok])
+                break
+            rows.append(st[:chunk])
+            forces.append(sd[: chunk + 1 if last else chunk])
+            after = st[chunk]
+            done += chunk
+            state = st[chunk - 1].copy()
+            lowest = contact_kinematics(scene, _states(rows[-1], nq, nv))[0].min(axis=1)
+            if lowest.min() < depth_limit:
+                status = Status.FAILED
+                bad = int(np.argmax(lowest < depth_limit))
+                message = f"the body fell through the ground at t = {rows[-1][bad, 0]:.6g}"
+                after = rows[-1][bad + 1] if bad + 1 < len(rows[-1]) else None
+                rows[-1] = rows[-1][: bad + 1]
+                forces[-1] = forces[-1][: bad + 2]
+                break
+    except KeyboardInterrupt:  # keep the whole steps done so far
+        interrupted = True
+        status = Status.FAILED
+        message = f"interrupted (Ctrl-C) at t = {done * dt:.6g}; the steps before are kept"
+        rows, after = [np.concatenate(rows)[: done + 1]], None
 
     rows_all = np.concatenate(rows)
     t = dt * np.arange(len(rows_all))  # = MuJoCo's time, without its accumulated roundoff
@@ -200,6 +251,8 @@ def run_mujoco(
         "restitution_model": settings.restitution_model,
         "mujoco_version": mujoco.__version__,
     }
+    if interrupted:
+        stats["interrupted"] = True
     return MujocoRun(scene, profile, dt, t, states, impulses, status, message, stats)
 
 
@@ -210,13 +263,16 @@ def simulate_mujoco(
     profile: str = "tuned",
     sample_every: int = 1,
     half_step: bool | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
     """Run the scene in MuJoCo (`run_mujoco`) and return its Trajectory: samples every
     step (thinned by `sample_every`), impacts = onsets of contact force per contact point
     (engines.base).  stats: wall_time_s (model build + stepping + conversion, not the
     Trajectory assembly), steps, steps_per_s (stepping alone), and the profile's
     parameters."""
-    run = run_mujoco(scene, dt, t_end=t_end, profile=profile, half_step=half_step)
+    run = run_mujoco(
+        scene, dt, t_end=t_end, profile=profile, half_step=half_step, progress=progress
+    )
     return build_trajectory(
         scene,
         ENGINE_NAMES[profile],

@@ -54,6 +54,7 @@ import math
 import os
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,6 +76,8 @@ ENGINE_NAMES = {"tuned": "pybullet", "default": "pybullet-default"}
 # three_point distance error r(1 − cos α) and the mapping of points to vertices are
 # negligible, and large against roundoff of the positions (1e-16 a).
 SPHERE_RADIUS = 1e-3
+# Steps between two progress reports (about a second of stepping at 5e4 steps/s).
+PROGRESS_EVERY = 50_000
 # Thickness of the body face used on three_point ground, relative to a.  Only its bottom
 # face (the mid-plane) touches the bumps; thick enough that a bump never crosses the
 # whole box in one step of a sane run.
@@ -370,8 +373,12 @@ def simulate_pybullet(
     t_end: float | None = None,
     profile: str = "tuned",
     sample_every: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
     """Run the scene in PyBullet at fixed step dt up to t_end (scene.run.t_end by default).
+
+    `progress(done, total)` is called every PROGRESS_EVERY steps.  Ctrl-C stops the run
+    after the current step: status failed, stats["interrupted"], the steps so far kept.
 
     Rows of the result: t = 0 (the initial state read back from PyBullet), every step
     around contact activity, and every `sample_every`-th step in between (default: steps
@@ -391,7 +398,7 @@ def simulate_pybullet(
     a = scene.body.radius
     if sample_every is None:
         time_unit = math.sqrt(a / scene.gravity) if scene.gravity > 0 else 1.0
-        sample_every = max(1, int(1e-3 * time_unit / dt))
+        sample_every = max(1, min(n_steps, int(1e-3 * time_unit / dt)))
     flat = scene.ground.kind == "flat"
     n_contacts = scene.n_contacts
 
@@ -414,12 +421,15 @@ def simulate_pybullet(
     limit = -FALL_THROUGH * a
     every_step = not flat
     wall0 = time.perf_counter()
+    interrupted = False
     try:
         rows_j.append(0)
         rows_raw.append(
             get_pose(body, physicsClientId=client) + get_vel(body, physicsClientId=client)
         )
         for j in range(1, n_steps + 1):
+            if progress is not None and j % PROGRESS_EVERY == 0:
+                progress(j, n_steps)
             step(physicsClientId=client)
             cps = contacts(bodyA=body, physicsClientId=client)
             for cp in cps:
@@ -442,6 +452,12 @@ def simulate_pybullet(
                     what = "fell through the ground" if depth <= limit else "non-finite state"
                     message = f"the body {what} at t = {j * dt:.6g}"
                     break
+    except KeyboardInterrupt:  # keep the rows read so far
+        interrupted = True
+        status = Status.FAILED
+        message = f"interrupted (Ctrl-C) at t = {rows_j[-1] * dt:.6g}; the steps before are kept"
+        kept = min(len(rows_j), len(rows_raw))
+        del rows_j[kept:], rows_raw[kept:]
     finally:
         pb.disconnect(client)
     wall = time.perf_counter() - wall0
@@ -463,6 +479,8 @@ def simulate_pybullet(
         "rows_read": int(len(J)),
         "rows_kept": int(keep.sum()),
     }
+    if interrupted:
+        stats["interrupted"] = True
     traj = build_trajectory(
         scene,
         ENGINE_NAMES[profile],

@@ -1,25 +1,60 @@
-"""Files at the edge: Trajectory → Parquet (samples and impacts); tables → CSV or Parquet
-without ever destroying a user's file."""
+"""Files at the edge: Trajectory → Parquet (samples and impacts); JSON without NaN."""
 
 from __future__ import annotations
 
 import json
-import os
-import tempfile
+import math
 from pathlib import Path
-
-import pyarrow as pa
-import pyarrow.parquet as pq
+from typing import Any
 
 from reference.trajectory import Trajectory
 
+from .outputs import OutputError, atomic_outputs, atomic_write, check_writable, show
 
-def write_trajectory_parquet(traj: Trajectory, path: str | Path) -> Path:
-    """Samples in FILE, impacts in FILE with `.impacts` before the suffix.
+
+def json_safe(x: Any) -> Any:
+    """JSON has no NaN/inf: map them to null (numpy scalars and arrays to Python)."""
+    import numpy as np
+
+    if isinstance(x, dict):
+        return {k: json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_safe(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return json_safe(x.tolist())
+    if isinstance(x, (np.floating, np.integer, np.bool_)):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def json_text(doc: Any, indent: int | None = None) -> str:
+    """One strict JSON document (no NaN or Infinity tokens)."""
+    return json.dumps(json_safe(doc), indent=indent, allow_nan=False, default=str)
+
+
+def impacts_path(path: str | Path) -> Path:
+    """The impacts file beside FILE: `.impacts` before the suffix."""
+    path = Path(path)
+    if not path.name or path.name in (".", ".."):
+        raise OutputError(f"{show(path)} names a directory; give a file name")
+    return path.with_name(path.stem + ".impacts" + (path.suffix or ".parquet"))
+
+
+def trajectory_paths(path: str | Path) -> list[Path]:
+    """Both files `write_trajectory_parquet` writes."""
+    return [Path(path), impacts_path(path)]
+
+
+def write_trajectory_parquet(traj: Trajectory, path: str | Path, force: bool = False) -> Path:
+    """Samples in FILE, impacts in FILE with `.impacts` before the suffix, both written
+    atomically (harness.outputs): complete, or not there at all.
 
     Both files carry the run's summary (status, message, ...) as schema metadata."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    import pyarrow as pa  # here: the CLI imports this module for json_text alone
+    import pyarrow.parquet as pq
+
     cols = {"t": traj.t}
     if traj.t_lo is not None:
         cols["t_lo"] = traj.t_lo
@@ -35,61 +70,47 @@ def write_trajectory_parquet(traj: Trajectory, path: str | Path) -> Path:
     cols["kinetic_energy"] = traj.kinetic_energy
     cols["potential_energy"] = traj.potential_energy
     cols["energy"] = traj.energy
-    meta = {b"summary": json.dumps(traj.summary(with_impacts=False), default=str).encode()}
+    meta = {b"summary": json_text(traj.summary(with_impacts=False)).encode()}
     table = pa.table(cols).replace_schema_metadata(meta)
-    pq.write_table(table, path)
     imp = pa.table(
         {
-            "t": [e.t for e in traj.impacts],
-            "t_lo": [e.t_lo for e in traj.impacts],
+            "t": pa.array([e.t for e in traj.impacts], type=pa.float64()),
+            "t_lo": pa.array([e.t_lo for e in traj.impacts], type=pa.float64()),
             "contact": pa.array([e.contact for e in traj.impacts], type=pa.int64()),
-            "impulse": [e.impulse for e in traj.impacts],
-            "v_normal_pre": [e.v_normal_pre for e in traj.impacts],
-            "v_normal_post": [e.v_normal_post for e in traj.impacts],
+            "impulse": pa.array([e.impulse for e in traj.impacts], type=pa.float64()),
+            "v_normal_pre": pa.array([e.v_normal_pre for e in traj.impacts], type=pa.float64()),
+            "v_normal_post": pa.array([e.v_normal_post for e in traj.impacts], type=pa.float64()),
         }
     ).replace_schema_metadata(meta)
-    ipath = path.with_name(path.stem + ".impacts" + (path.suffix or ".parquet"))
-    pq.write_table(imp, ipath)
-    return path
+    with atomic_outputs(trajectory_paths(path), force) as (samples_tmp, impacts_tmp):
+        pq.write_table(table, samples_tmp)
+        pq.write_table(imp, impacts_tmp)
+    return Path(path)
 
 
 TABLE_SUFFIXES = (".csv", ".parquet")
 
 
-def check_table_path(path: str | Path, force: bool = False) -> Path:
-    """The path a table may be written to: a `.csv` or `.parquet` name, not an existing
-    file unless `force`.  Raises ValueError (bad input) otherwise; meant to be called
-    before any work is done."""
-    p = Path(path)
-    if p.suffix.lower() not in TABLE_SUFFIXES:
-        raise ValueError(f"{p}: the file name must end in .csv or .parquet")
-    if p.exists() and not force:
-        raise ValueError(f"{p} exists; pass --force to replace it")
-    if p.exists() and not p.is_file():
-        raise ValueError(f"{p} exists and is not a file")
-    return p
+def check_table_path(
+    path: str | Path, force: bool = False, inputs: tuple[str | Path, ...] = ()
+) -> Path:
+    """The path a table may be written to: a `.csv` or `.parquet` name that
+    harness.outputs.check_writable accepts (not an existing file unless `force`, not an
+    input).  Raises OutputError; meant to be called before any work is done."""
+    return check_writable(path, force, inputs, what="table", suffixes=TABLE_SUFFIXES)
 
 
-def write_table(table: pa.Table, path: str | Path, force: bool = False) -> Path:
-    """Write `table` as CSV or Parquet (by suffix) atomically: into a temporary file in
-    the same folder, then renamed over the name (os.replace), so a reader never sees a
-    half-written file and an interrupted write leaves the old one.  An existing file is
-    replaced only with `force` (`check_table_path`)."""
+def write_table(table: Any, path: str | Path, force: bool = False) -> Path:
+    """Write a pyarrow table as CSV or Parquet (by suffix), atomically
+    (harness.outputs.atomic_write: complete or not there at all)."""
     p = check_table_path(path, force)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-    os.close(fd)
-    try:
+    with atomic_write(p, force) as tmp:
         if p.suffix.lower() == ".csv":
             import pyarrow.csv as pcsv
 
             pcsv.write_csv(table, tmp)
         else:
+            import pyarrow.parquet as pq
+
             pq.write_table(table, tmp)
-        if p.exists() and not force:  # appeared while we wrote
-            raise ValueError(f"{p} exists; pass --force to replace it")
-        os.replace(tmp, p)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return p

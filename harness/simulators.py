@@ -16,6 +16,7 @@ whose entry point fails to load (import error, exception at import, not callable
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import metadata
@@ -25,6 +26,9 @@ from reference.trajectory import Trajectory
 
 GROUP = "harness.engines"
 DEFAULT_DT = 1e-4
+# Steps a fixed-step run may take unless --max-steps says otherwise: MuJoCo keeps about
+# 0.6 kB per step (696 MB measured for 1e6 steps), so 1e7 steps stay within ~6 GB.
+DEFAULT_MAX_STEPS = 10_000_000
 # Listed first, in this order, when installed; everything else follows by name.
 _FIRST = ("reference", "linear")
 
@@ -116,20 +120,88 @@ def check_engine(name: str) -> str:
 
 
 def run_simulator(
-    engine: str, scene: Scene, dt: float | None = None, t_end: float | None = None
+    engine: str,
+    scene: Scene,
+    dt: float | None = None,
+    t_end: float | None = None,
+    *,
+    max_steps: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
     """Run one simulator on one scene.  `dt` applies to fixed-step engines only, which
-    get DEFAULT_DT when it is None; other engines get dt = None."""
+    get DEFAULT_DT when it is None; other engines get dt = None.
+
+    Before the run, `check_run` (SceneError on bad input).  `progress(done, total)`
+    reaches engines that report progress (their `reports_progress` attribute).  After
+    the run, harness.guard: a sample that is no valid state (NaN, a quaternion far from
+    unit norm, a body through the ground) ends the run `failed` there.  An engine that
+    raises (e.g. MuJoCo refusing a mass below its 1e-15 floor) gives a `failed` run with
+    the error as its message and the traceback's end in stats["error"]."""
+    from .guard import guard_trajectory
+
     simulate = load_engine(engine)
-    if dt is not None and not dt > 0:
-        raise SceneError(f"--dt must be > 0, got {dt}")
-    if t_end is not None and not t_end > 0:
-        raise SceneError(f"--t-end must be > 0, got {t_end}")
-    step = (dt or DEFAULT_DT) if is_fixed_step(engine) else None
-    traj = simulate(scene, dt=step, t_end=t_end)
+    step = check_run(engine, scene, dt, t_end, max_steps)
+    extra = {}
+    if progress is not None and getattr(simulate, "reports_progress", False):
+        extra["progress"] = progress
+    try:
+        traj = simulate(scene, dt=step, t_end=t_end, **extra)
+    except SceneError:
+        raise
+    except Exception as exc:  # the engine broke on this scene: a result, not a crash
+        traj = Trajectory.failed(
+            engine, scene.name, step, f"{engine} raised {type(exc).__name__}: {exc}"
+        )
+        traj.stats = {"error": _error_text(exc)}
     if not isinstance(traj, Trajectory):
         raise TypeError(f"engine {engine!r} returned {type(traj).__name__}, not a Trajectory")
-    return traj
+    return guard_trajectory(scene, traj)
+
+
+def _error_text(exc: BaseException, limit: int = 2000) -> str:
+    """The last frames of an engine's traceback, for the run's stats."""
+    import traceback
+
+    text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__, limit=-4))
+    return text.strip()[-limit:]
+
+
+def check_run(
+    engine: str,
+    scene: Scene,
+    dt: float | None = None,
+    t_end: float | None = None,
+    max_steps: int | None = None,
+) -> float | None:
+    """Everything a run needs, checked before it starts (SceneError, exit status 2):
+    t_end in the scene's range (and the scene's speed group with that t_end), the
+    engine's vertex limit (`max_vertices` attribute of its entry point), and for
+    fixed-step engines 0 < dt <= t_end and t_end / dt <= max_steps
+    (DEFAULT_MAX_STEPS).  Returns the timestep the engine gets (None: not fixed-step)."""
+    simulate = load_engine(engine)
+    if dt is not None and not (math.isfinite(dt) and dt > 0):
+        raise SceneError(f"--dt must be > 0, got {dt}")
+    if t_end is not None:
+        scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
+    limit = getattr(simulate, "max_vertices", None)
+    if limit is not None and scene.body.n > limit:
+        raise SceneError(
+            f"engine {engine!r} takes polygons of at most {limit} vertices, got n = {scene.body.n}"
+        )
+    if not is_fixed_step(engine):
+        return None
+    step = dt or DEFAULT_DT
+    horizon = scene.run.t_end
+    if step > horizon:
+        raise SceneError(f"--dt ({step:g}) must not exceed t_end ({horizon:g})")
+    ceiling = DEFAULT_MAX_STEPS if max_steps is None else max_steps
+    steps = horizon / step
+    if steps > ceiling:
+        raise SceneError(
+            f"t_end / dt = {horizon:g} / {step:g} = {steps:.3g} steps exceeds the ceiling of "
+            f"{ceiling:g}; use a larger --dt, a shorter --t-end, or raise --max-steps"
+        )
+    return step
 
 
 # Warm-up run: this many steps of a fixed-step engine, or this fraction of the scene's
@@ -153,9 +225,7 @@ def warm_up(engine: str, scene: Scene, dt: float | None = None) -> float:
     t_short = WARM_UP_STEPS * step if step else WARM_UP_FRACTION * scene.run.t_end
     try:
         run_simulator(engine, scene, dt=step, t_end=min(t_short, scene.run.t_end))
-    except SceneError:
-        raise
-    except Exception:  # noqa: BLE001  (the timed run reports it)
+    except Exception:  # noqa: BLE001  (the timed run checks its input and reports it)
         pass
     _warm.add(engine)
     return time.perf_counter() - start

@@ -4,6 +4,33 @@ A scene is a regular n-gon (or a disk on three ground bumps), its ground, its in
 state and how long to run.  The TOML layout is fixed by CONTRACT.md; this module turns
 a parsed mapping into a frozen :class:`Scene` and rejects bad input with
 :class:`SceneError` (one clear sentence, never a traceback at the CLI).
+
+Accepted ranges (docs/inputs.md gives the reasons and the measurements behind them).
+Units: the body's radius a, its mass m, and the time unit τ = min(√(a/g), t_end) (t_end
+alone when g = 0), with the velocity unit U = a/τ = max(√(g a), a/t_end):
+
+- a, m, g (when > 0), t_end in DIMENSION_RANGE: the code forms products of up to six
+  such numbers (e.g. the rotational energy ½ m ρ² a² ω²), which stay within 1e±300,
+  inside double precision's 1e±308;
+- ρ in GYRATION_RANGE: the impact law adds 1/m and a²/(m ρ² a²); with ρ² within
+  1e±12 of 1 the smaller keeps four of its sixteen digits;
+- 2 ≤ n ≤ MAX_VERTICES: beyond, the polygon differs from its circle by
+  a (1 − cos π/n) < 5e-12 a; the per-vertex arrays cost O(n) memory;
+- bump_radius / a in [MIN_BUMP_RADIUS, 1);
+- speed group (|v| + |ω| a) / U ≤ MAX_SPEED, i.e. v²/(g a) and ω² a/g ≤ 1e6: the
+  reference's tolerances follow the body's velocity scale V (velocity noise 64 ε V,
+  chatter completed below 1e-6 V), and on flat ground the horizontal velocity and the
+  spin about the vertical never decay, so V stays large while the vertical motion it
+  must resolve dies out (measured with an added horizontal velocity: the end time
+  agrees to 11 digits up to V/U = 1e3, moves by 5 % at 3e3, and one run takes 45 s at
+  1e8);
+- |position| / a ≤ MAX_POSITION (contact gaps keep ≥ 10 digits of a), |rotation
+  vector| ≤ MAX_ROTATION_VECTOR rad (the attitude's roundoff ε |φ| stays below 2e-13);
+  the tilt α itself needs no limit (the geometry keeps tilts of 1e-15 exactly);
+- the linear scale ε (`initial.scale`, `--scale`) in SCALE_RANGE (ε² q underflows or
+  overflows beyond), and the scaled scene passes the same checks;
+- run.max_impacts ≤ MAX_IMPACTS (about 0.25 kB of memory per impact: 296 MB measured
+  for 1e6 impacts).
 """
 
 from __future__ import annotations
@@ -22,6 +49,19 @@ from .quaternion import body_axis
 
 class SceneError(ValueError):
     """A scene that cannot be simulated: the message says which field and why."""
+
+
+DIMENSION_RANGE = (1e-50, 1e50)
+GYRATION_RANGE = (1e-6, 1e6)
+MAX_VERTICES = 1_000_000
+MIN_BUMP_RADIUS = 1e-6
+MAX_SPEED = 1e3
+MAX_POSITION = 1e6
+MAX_ROTATION_VECTOR = 1e3
+SCALE_RANGE = (1e-50, 1e50)
+MAX_IMPACTS = 10_000_000
+MAX_SCENE_FILE_BYTES = 1 << 20
+MAX_NAME_LENGTH = 200
 
 
 @dataclass(frozen=True)
@@ -82,17 +122,32 @@ class Scene:
         return 3 if self.ground.kind == "three_point" else self.body.n
 
     def with_run(self, **changes: Any) -> Scene:
-        return replace(self, run=replace(self.run, **changes))
+        """The scene with other run settings, checked like a scene file's [run]
+        (a longer t_end lowers the velocity unit U of the speed check)."""
+        if "t_end" in changes:
+            _check_in_range("t_end", changes["t_end"], DIMENSION_RANGE)
+        if "max_impacts" in changes:
+            _check_max_impacts(changes["max_impacts"])
+        scene = replace(self, run=replace(self.run, **changes))
+        check_scene(scene)
+        return scene
 
-    def scaled(self, eps: float) -> Scene:
+    def scaled(self, eps: float, name: str = "--scale") -> Scene:
         """Apply the paper's scaling invariance to the linear initial coordinates:
-        q → ε² q, p → ε p (section 2.5).  Only defined for scenes given by (q, p)."""
+        q → ε² q, p → ε p (section 2.5).  Only defined for scenes given by (q, p).
+        The result passes the same checks as a scene file (check_scene), the
+        below-ground check included."""
         if self.initial.q is None or self.initial.p is None:
-            raise SceneError("--scale needs a scene whose [initial] is given by q and p")
-        _check_positive("scale", eps)
-        q = tuple(eps * eps * x for x in self.initial.q)
-        p = tuple(eps * x for x in self.initial.p)
-        return replace(self, initial=initial_from_linear(q, p))
+            raise SceneError(f"{name} needs a scene whose [initial] is given by q and p")
+        scene = replace(self, initial=scaled_initial(self.initial.q, self.initial.p, eps, name))
+        check_scene(scene)
+        return scene
+
+
+def scaled_initial(q, p, eps: float, name: str = "scale") -> InitialState:
+    """The full state of linear coordinates scaled by ε: (ε² q, ε p)."""
+    _check_in_range(name, eps, SCALE_RANGE)
+    return initial_from_linear([eps * eps * x for x in q], [eps * x for x in p])
 
 
 def initial_from_linear(q, p) -> InitialState:
@@ -121,58 +176,103 @@ _RUN_KEYS = {"t_end", "max_impacts"}
 
 
 def load_scene(path: str | Path) -> Scene:
-    """Read and validate a scene file."""
+    """Read and validate a scene file (a regular UTF-8 TOML file of at most
+    MAX_SCENE_FILE_BYTES)."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"scene file not found: {path}")
+    shown = show_path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        if not path.exists():
+            raise SceneError(f"scene file not found: {shown}")
+        if not path.is_file():
+            raise SceneError(f"{shown} is not a regular file (a scene is a TOML file)")
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_SCENE_FILE_BYTES + 1)
+    except OSError as exc:
+        raise SceneError(f"cannot read scene file {shown}: {exc.strerror or exc}") from None
+    except ValueError as exc:  # e.g. a NUL character in the path
+        raise SceneError(f"cannot read scene file {shown}: {exc}") from None
+    if len(raw) > MAX_SCENE_FILE_BYTES:
+        raise SceneError(f"{shown} is larger than {MAX_SCENE_FILE_BYTES} bytes: not a scene file")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SceneError(f"{shown} is not UTF-8 text (scene files are TOML)") from None
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: malformed TOML: {exc}") from None
+        raise SceneError(f"{shown}: malformed TOML: {exc}") from None
+    except RecursionError:
+        raise SceneError(f"{shown}: TOML nested too deeply to be a scene") from None
     return scene_from_dict(data, default_name=path.stem)
 
 
+def show_path(path: str | Path, limit: int = 80) -> str:
+    """A path for a one-line message: long ones shortened in the middle."""
+    text = repr(str(path))[1:-1]
+    if len(text) <= limit:
+        return text
+    return f"{text[: limit // 2 - 2]}...{text[-(limit // 2 - 1) :]}"
+
+
 def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
+    """Validate a parsed scene mapping (the TOML layout of CONTRACT.md) into a Scene:
+    every field's type and range, then the checks of `check_scene`."""
+    if not isinstance(data, dict):
+        raise SceneError(f"a scene is a TOML table, got {type(data).__name__}")
     _check_keys("scene", data, _TOP_KEYS)
-    name = str(data.get("name", default_name))
     gravity = _number("gravity", data.get("gravity", 1.0))
-    if gravity < 0:
-        raise SceneError(f"gravity must be >= 0, got {gravity}")
+    if gravity != 0.0:
+        _check_in_range("gravity", gravity, DIMENSION_RANGE, zero_ok=True)
     gamma = _number("restitution", data.get("restitution", 0.5))
     if not 0.0 <= gamma <= 1.0:
         raise SceneError(f"restitution must be in [0, 1], got {gamma}")
+    body = _parse_body(_table("body", data))
+    scene = Scene(
+        name=_text("name", data.get("name", default_name)),
+        description=_text("description", data.get("description", "")),
+        gravity=gravity,
+        restitution=gamma,
+        body=body,
+        ground=_parse_ground(_optional_table("ground", data), body),
+        initial=_parse_initial(_table("initial", data)),
+        run=_parse_run(_optional_table("run", data)),
+    )
+    check_scene(scene)
+    return scene
 
-    b = _table("body", data)
+
+def _parse_body(b: dict) -> Body:
     _check_keys("[body]", b, _BODY_KEYS)
     if "n" not in b:
         raise SceneError("[body] needs n (number of vertices, >= 2)")
     n = b["n"]
     if isinstance(n, bool) or not isinstance(n, int):
         raise SceneError(f"body.n must be an integer, got {n!r}")
-    if n < 2:
-        raise SceneError(f"body.n must be >= 2 (2 is the rod), got {n}")
-    body = Body(
+    if not 2 <= n <= MAX_VERTICES:
+        raise SceneError(f"body.n must be in [2, {MAX_VERTICES}] (2 is the rod), got {n}")
+    return Body(
         n=n,
-        radius=_positive("body.radius", b.get("radius", 1.0)),
-        mass=_positive("body.mass", b.get("mass", 1.0)),
-        gyration=_positive("body.gyration", b.get("gyration", 0.5)),
+        radius=_in_range("body.radius", b.get("radius", 1.0), DIMENSION_RANGE),
+        mass=_in_range("body.mass", b.get("mass", 1.0), DIMENSION_RANGE),
+        gyration=_in_range("body.gyration", b.get("gyration", 0.5), GYRATION_RANGE),
     )
 
-    gr = data.get("ground", {})
-    if not isinstance(gr, dict):
-        raise SceneError("[ground] must be a table")
+
+def _parse_ground(gr: dict, body: Body) -> Ground:
     _check_keys("[ground]", gr, _GROUND_KEYS)
     kind = gr.get("kind", "flat")
     if kind not in ("flat", "three_point"):
         raise SceneError(f"ground.kind must be 'flat' or 'three_point', got {kind!r}")
-    bump = _positive("ground.bump_radius", gr.get("bump_radius", 0.5 * body.radius))
-    if kind == "three_point" and bump >= body.radius:
+    bump = _number("ground.bump_radius", gr.get("bump_radius", 0.5 * body.radius))
+    if kind == "three_point" and not MIN_BUMP_RADIUS <= bump / body.radius < 1.0:
         raise SceneError(
-            f"ground.bump_radius ({bump}) must be smaller than body.radius ({body.radius})"
+            f"ground.bump_radius must be in [{MIN_BUMP_RADIUS:g}, 1) x body.radius "
+            f"({body.radius:g}), got {bump:g}"
         )
-    ground = Ground(kind=kind, bump_radius=bump)
+    if kind == "flat" and not bump > 0:
+        raise SceneError(f"ground.bump_radius must be > 0, got {bump!r}")
+    return Ground(kind=kind, bump_radius=bump)
 
-    ini = _table("initial", data)
+
+def _parse_initial(ini: dict) -> InitialState:
     keys = set(ini)
     if keys & _INITIAL_LINEAR and keys & _INITIAL_FULL:
         raise SceneError("[initial] gives either q/p (linear) or position/... (full), not both")
@@ -182,41 +282,80 @@ def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
             raise SceneError("[initial] in linear coordinates needs both q and p")
         q = _vector("initial.q", ini["q"])
         p = _vector("initial.p", ini["p"])
-        s = _positive("initial.scale", ini.get("scale", 1.0))
-        initial = initial_from_linear([s * s * x for x in q], [s * x for x in p])
-    else:
-        _check_keys("[initial]", ini, _INITIAL_FULL)
-        missing = _INITIAL_FULL - keys
-        if missing:
-            raise SceneError(f"[initial] is missing {', '.join(sorted(missing))}")
-        initial = InitialState(
-            position=_vector("initial.position", ini["position"]),
-            rotation_vector=_vector("initial.rotation_vector", ini["rotation_vector"]),
-            velocity=_vector("initial.velocity", ini["velocity"]),
-            angular_velocity=_vector("initial.angular_velocity", ini["angular_velocity"]),
-        )
+        eps = _number("initial.scale", ini.get("scale", 1.0))
+        return scaled_initial(q, p, eps, "initial.scale")
+    _check_keys("[initial]", ini, _INITIAL_FULL)
+    missing = _INITIAL_FULL - keys
+    if missing:
+        raise SceneError(f"[initial] is missing {', '.join(sorted(missing))}")
+    return InitialState(
+        position=_vector("initial.position", ini["position"]),
+        rotation_vector=_vector("initial.rotation_vector", ini["rotation_vector"]),
+        velocity=_vector("initial.velocity", ini["velocity"]),
+        angular_velocity=_vector("initial.angular_velocity", ini["angular_velocity"]),
+    )
 
-    r = data.get("run", {})
-    if not isinstance(r, dict):
-        raise SceneError("[run] must be a table")
+
+def _parse_run(r: dict) -> RunSettings:
     _check_keys("[run]", r, _RUN_KEYS)
     mi = r.get("max_impacts", 100_000)
-    if isinstance(mi, bool) or not isinstance(mi, int) or mi < 0:
-        raise SceneError(f"run.max_impacts must be a non-negative integer, got {mi!r}")
-    run = RunSettings(t_end=_positive("run.t_end", r.get("t_end", 5.0)), max_impacts=mi)
-
-    scene = Scene(
-        name=name,
-        description=str(data.get("description", "")),
-        gravity=gravity,
-        restitution=gamma,
-        body=body,
-        ground=ground,
-        initial=initial,
-        run=run,
+    _check_max_impacts(mi)
+    return RunSettings(
+        t_end=_in_range("run.t_end", r.get("t_end", 5.0), DIMENSION_RANGE), max_impacts=mi
     )
+
+
+# --------------------------------------------------------------------------- checks
+
+
+def check_scene(scene: Scene) -> None:
+    """The checks that involve several fields: the initial state within what the
+    method resolves (position, attitude, the speed group) and not below the ground."""
+    check_initial_state(scene)
     check_not_below_ground(scene)
-    return scene
+
+
+def velocity_unit(scene: Scene) -> float:
+    """U = a/τ = max(√(g a), a/t_end): the speed unit of the speed group."""
+    a = scene.body.radius
+    return max(math.sqrt(scene.gravity * a), a / scene.run.t_end)
+
+
+def check_initial_state(scene: Scene) -> None:
+    """Reject initial states that double precision or the reference cannot resolve
+    (module docstring): |x_i| ≤ MAX_POSITION a, |φ| ≤ MAX_ROTATION_VECTOR, and the
+    speed group (|v| + |ω| a) / U ≤ MAX_SPEED."""
+    ini = scene.initial
+    a = scene.body.radius
+    for name, vec in (
+        ("position", ini.position),
+        ("rotation_vector", ini.rotation_vector),
+        ("velocity", ini.velocity),
+        ("angular_velocity", ini.angular_velocity),
+    ):
+        if not all(math.isfinite(x) for x in vec):
+            raise SceneError(f"initial {name} must be finite, got {list(vec)}")
+    far = max(abs(x) for x in ini.position) / a
+    if far > MAX_POSITION:
+        raise SceneError(
+            f"initial position is {far:.3g} body radii from the origin; at most "
+            f"{MAX_POSITION:g} (contact gaps would lose the body's own size to roundoff)"
+        )
+    angle = math.hypot(*ini.rotation_vector)
+    if angle > MAX_ROTATION_VECTOR:
+        raise SceneError(
+            f"initial rotation vector has angle {angle:.3g} rad; at most "
+            f"{MAX_ROTATION_VECTOR:g} (give the same attitude with an angle below 2 pi)"
+        )
+    speed = math.hypot(*ini.velocity) + math.hypot(*ini.angular_velocity) * a
+    group = speed / velocity_unit(scene)
+    if group > MAX_SPEED:
+        raise SceneError(
+            f"initial speed (|v| + |omega| a = {speed:.3g}) is {group:.3g} times the "
+            f"velocity unit max(sqrt(g a), a / t_end) = {velocity_unit(scene):.3g}; at most "
+            f"{MAX_SPEED:g} (v^2/(g a) and omega^2 a/g <= {MAX_SPEED**2:g}), beyond which "
+            "the reference cannot resolve the motion"
+        )
 
 
 def check_not_below_ground(scene: Scene) -> None:
@@ -235,7 +374,11 @@ def check_not_below_ground(scene: Scene) -> None:
 def _table(name: str, data: dict) -> dict:
     if name not in data:
         raise SceneError(f"scene has no [{name}] table")
-    t = data[name]
+    return _optional_table(name, data)
+
+
+def _optional_table(name: str, data: dict) -> dict:
+    t = data.get(name, {})
     if not isinstance(t, dict):
         raise SceneError(f"[{name}] must be a table")
     return t
@@ -244,33 +387,52 @@ def _table(name: str, data: dict) -> dict:
 def _check_keys(where: str, data: dict, allowed: set[str]) -> None:
     unknown = set(data) - allowed
     if unknown:
-        raise SceneError(
-            f"{where}: unknown key(s) {', '.join(sorted(unknown))}; "
-            f"allowed: {', '.join(sorted(allowed))}"
-        )
+        shown = ", ".join(sorted(show_path(k, 40) for k in unknown)[:5])
+        raise SceneError(f"{where}: unknown key(s) {shown}; allowed: {', '.join(sorted(allowed))}")
+
+
+def _text(name: str, value: Any) -> str:
+    if not isinstance(value, str):
+        raise SceneError(f"{name} must be a string, got {type(value).__name__}")
+    if len(value) > MAX_NAME_LENGTH or any(c in value for c in "\n\r\x00"):
+        raise SceneError(f"{name} must be one line of at most {MAX_NAME_LENGTH} characters")
+    return value
 
 
 def _number(name: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SceneError(f"{name} must be a number, got {value!r}")
-    x = float(value)
+        raise SceneError(f"{name} must be a number, got {show_path(repr(value), 40)}")
+    try:
+        x = float(value)
+    except OverflowError:  # an integer beyond double precision's range
+        raise SceneError(f"{name} must be finite, got {show_path(repr(value), 40)}") from None
     if not math.isfinite(x):
         raise SceneError(f"{name} must be finite, got {value!r}")
     return x
 
 
-def _positive(name: str, value: Any) -> float:
+def _in_range(name: str, value: Any, bounds: tuple[float, float]) -> float:
     x = _number(name, value)
-    _check_positive(name, x)
+    _check_in_range(name, x, bounds)
     return x
 
 
-def _check_positive(name: str, x: float) -> None:
-    if not (math.isfinite(x) and x > 0):
-        raise SceneError(f"{name} must be > 0, got {x!r}")
+def _check_in_range(name: str, x: Any, bounds: tuple[float, float], zero_ok=False) -> None:
+    lo, hi = bounds
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not lo <= x <= hi:
+        zero = "0 or " if zero_ok else ""
+        raise SceneError(f"{name} must be {zero}in [{lo:g}, {hi:g}], got {x!r}")
+
+
+def _check_max_impacts(mi: Any) -> None:
+    if isinstance(mi, bool) or not isinstance(mi, int) or not 0 <= mi <= MAX_IMPACTS:
+        raise SceneError(
+            f"run.max_impacts must be an integer in [0, {MAX_IMPACTS}], "
+            f"got {show_path(repr(mi), 40)}"
+        )
 
 
 def _vector(name: str, value: Any) -> tuple[float, float, float]:
     if not isinstance(value, list) or len(value) != 3:
-        raise SceneError(f"{name} must be a list of 3 numbers, got {value!r}")
+        raise SceneError(f"{name} must be a list of 3 numbers, got {show_path(repr(value), 60)}")
     return tuple(_number(f"{name}[{i}]", v) for i, v in enumerate(value))

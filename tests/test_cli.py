@@ -127,7 +127,8 @@ def test_selfsimilar_table_names_the_kind_of_every_solution(capsys):
         == 0
     )
     doc = json.loads(capsys.readouterr().out)
-    rows = [line.split() for line in text.splitlines()[3:]]
+    table = text.split("\n\n")[0]  # the legend follows after a blank line
+    rows = [line.split() for line in table.splitlines()[3:]]
     assert len(rows) == len(doc["solutions"]) > 0
     for row, sol in zip(rows, doc["solutions"], strict=True):
         assert row[1] == ("trivial" if sol["trivial"] else "nontrivial")

@@ -57,7 +57,7 @@ def calls(monkeypatch):
     """Replace the simulators: record every call; 'pybullet' raises."""
     made: list[tuple[str, float | None]] = []
 
-    def fake(engine, scene, dt=None, t_end=None):
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
         made.append((engine, dt))
         if engine == "pybullet":
             raise RuntimeError("engine exploded")
@@ -98,7 +98,7 @@ def test_a_failing_engine_is_a_failed_row_not_a_crash(calls):
 
 
 def test_bad_input_still_stops_the_command(monkeypatch):
-    def bad(engine, scene, dt=None, t_end=None):
+    def bad(engine, scene, dt=None, t_end=None, **_limits):
         raise SceneError("--dt must be > 0")
 
     monkeypatch.setattr(C, "run_simulator", bad)
@@ -145,7 +145,7 @@ def test_report_names_who_diverges_first_when_and_why(monkeypatch):
     """mujoco's second impact is 0.1 s late, linear's first hits another contact: linear
     diverges first, at its first impact, because of the contact."""
 
-    def fake(engine, scene, dt=None, t_end=None):
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
         traj = stand_in(engine, dt)
         if engine == "mujoco":
             traj.impacts[1] = ImpactEvent(0.7, 1, 1.0, -0.5, 0.25)
@@ -202,7 +202,7 @@ def test_impact_diff_pairs_every_reference_impact_with_the_run_impact(tmp_path, 
 def test_impact_diff_marks_the_first_mismatch_and_what_follows(monkeypatch, tmp_path):
     from harness.compare.diff import impact_diff
 
-    def fake(engine, scene, dt=None, t_end=None):
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
         traj = stand_in(engine, dt)
         if engine == "mujoco":
             traj.impacts[0] = ImpactEvent(0.3, 3, 1.0, -1.0, 0.5)

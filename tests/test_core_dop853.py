@@ -11,8 +11,8 @@ from scipy.integrate._ivp import dop853_coefficients as scipy_dop
 
 from reference import quaternion as qt
 from reference.core import dop853_tableau as tab
-from reference.core.contacts import vertex_lever
-from reference.core.dop853 import INT_DONE, integrate_held
+from reference.core.contacts import contact_frame, vertex_lever
+from reference.core.dop853 import INT_CROSSING, INT_DONE, integrate_held
 from reference.core.held import held_rhs, new_work
 from reference.core.output import Output
 from tests.conftest import core_model, make_scene
@@ -26,6 +26,9 @@ def test_tableau_is_scipys():
     np.testing.assert_array_equal(tab.C, scipy_dop.C[:n])
     np.testing.assert_array_equal(tab.E3, scipy_dop.E3)
     np.testing.assert_array_equal(tab.E5, scipy_dop.E5)
+    np.testing.assert_array_equal(tab.A_EXTRA, scipy_dop.A[n + 1 :])
+    np.testing.assert_array_equal(tab.C_EXTRA, scipy_dop.C[n + 1 :])
+    np.testing.assert_array_equal(tab.D, scipy_dop.D)
 
 
 def _held_state(two: bool):
@@ -71,8 +74,49 @@ def test_integration_is_scipys_dop853_step_for_step(two):
     ours = new_work()
     r = integrate_held(
         y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], np.zeros(0), 0, out,
-        (0.0, 0.0), 0, False,
+        (0.0, 0.0), 0, False, np.zeros(0, dtype=np.int64), 0,
     )  # fmt: skip
     assert r.status == INT_DONE
     assert r.nfev == ref.nfev
     np.testing.assert_allclose(y, ref.y[:, -1], rtol=0, atol=1e-13)
+
+
+def test_crossing_is_located_where_scipys_event_finds_it():
+    """A free vertex of a pentagon rocking on one held vertex reaches the ground at the
+    time scipy's solve_ivp event location gives (DOP853 dense output, brentq)."""
+    scene = make_scene(n=5, rho=0.45)
+    model, pts = core_model(scene)
+    idx, m = np.array([0, 0, 0]), 1
+    y0 = _held_state(False)
+    rtol, atol = 1e-12, np.full(13, 1e-14)
+    scratch = new_work()
+
+    def rhs(_t, y):
+        dy = np.empty(13)
+        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, scratch[0], dy)
+        return dy
+
+    def gap_event(k):
+        def gap(_t, y):
+            return contact_frame(np.ascontiguousarray(y), model["flat_ground"], pts, k).gap
+
+        gap.terminal, gap.direction = True, -1
+        return gap
+
+    events = [gap_event(k) for k in range(1, 5)]
+    ref = solve_ivp(rhs, (0.0, 2.0), y0, method="DOP853", rtol=rtol, atol=atol, events=events)
+    t_ref = min(te[0] for te in ref.t_events if len(te))
+    first = [k + 1 for k, te in enumerate(ref.t_events) if len(te) and te[0] == t_ref]
+    y = y0.copy()
+    out = Output(
+        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
+        np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
+    )  # fmt: skip
+    watch = np.arange(1, 5, dtype=np.int64)
+    r = integrate_held(
+        y, 2.0, model, pts, idx, m, rtol, atol, scratch[0], scratch[0], np.zeros(0), 0, out,
+        (0.0, 0.0), 0, False, watch, 4,
+    )  # fmt: skip
+    assert r.status == INT_CROSSING
+    assert abs(r.s - t_ref) < 1e-10
+    assert abs(contact_frame(y, model["flat_ground"], pts, first[0]).gap) < 1e-12

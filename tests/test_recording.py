@@ -334,9 +334,17 @@ def test_compare_records_its_runs_with_their_verdicts(tmp_path, capsys):
 def test_bare_file_name_goes_under_recordings(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert recording_path("run.rrd") == Path("recordings/run.rrd")
-    assert (tmp_path / "recordings").is_dir()
+    assert recording_path("./run.rrd") == Path("run.rrd")
     assert recording_path("out/deep/run.rrd") == Path("out/deep/run.rrd")
-    assert (tmp_path / "out/deep").is_dir()
+    assert not (tmp_path / "recordings").exists()  # created only when a recording is written
+
+
+def test_recording_creates_its_folders_when_written(tmp_path):
+    path = record_trajectories(
+        [synthetic_trajectory("reference")], tmp_path / "out/deep/run.rrd", make_scene()
+    )
+    assert path.is_file() and path.parent == tmp_path / "out/deep"
+    assert [p.name for p in path.parent.iterdir()] == ["run.rrd"]  # no temporary file left
 
 
 def test_entity_names_are_unique_per_run():

@@ -126,3 +126,21 @@ def test_gamma_zero_heavy_rim_triangle_reaches_the_singularity():
     traj = simulate(make_scene(n=3, rho=1.0, gamma=0.0, q=q, p=p, t_end=200.0))
     assert traj.status.value == "singularity"
     assert traj.t_singularity is not None and traj.t_singularity > traj.impacts[-1].t - 1e-9
+
+
+def test_impact_ending_a_contact_phase_is_where_the_gap_is_zero():
+    """The impact of a vertex that reaches the ground during a contact phase (γ = 0, a
+    rolling square) is at the time a run with a 100× tighter integration tolerance gives:
+    it is located on the gap's zero, not where the gap came within the integrator's
+    resolution (which would put it ~1e-10 early on these grazing approaches)."""
+    from reference import ReferenceOptions
+
+    scene = make_scene(n=4, gamma=0.0, rho=0.45, q=(0.012, -0.007, 0.05), p=(0.2, -0.15, -0.5))
+    run = simulate(scene)
+    tight = simulate(scene, options=ReferenceOptions(contact_rtol=1e-14))
+    assert run.stats.contact_phases >= 5
+    n = min(len(run.impacts), len(tight.impacts))
+    assert n >= 10
+    for a, b in zip(run.impacts[:n], tight.impacts[:n], strict=True):
+        assert a.contact == b.contact
+        assert abs(a.t - b.t) <= 1e-11

@@ -14,7 +14,7 @@ from reference.core.records import EVENT_IMPACT, EVENT_NONE
 from reference.core.search import find_flight_event
 from reference.geometry import initial_state
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
-from tests.conftest import core_model, flight, gaps
+from tests.conftest import core_model, flight, gaps, make_scene
 from tests.oracle.body import BodyModel
 from tests.oracle.events import next_flight_event
 from tests.oracle.flight import flight_constants as oracle_flight_constants
@@ -113,3 +113,20 @@ def test_large_n_runs_agree_with_every_vertex_runs(n, n_compare):
     for a, b in zip(win.impacts, full.impacts, strict=True):
         assert a.contact == b.contact
         assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-12
+
+
+@pytest.mark.parametrize("n,gamma,count", [(200, 0.0, 150), (1000, 0.0, 150), (1000, 0.5, 1500)])
+def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma, count):
+    """Rolling and rocking large polygons (γ = 0: one contact phase per impact): contact
+    steps that examine a window of vertices give the impacts of steps that examine all."""
+    scene = make_scene(
+        n=n, gamma=gamma, rho=0.45, q=(0.012, -0.007, 0.05), p=(0.2, -0.15, -0.5),
+        t_end=100.0, max_impacts=count,
+    )  # fmt: skip
+    win = simulate(scene)
+    full = simulate(scene, options=ReferenceOptions(window_search=False))
+    assert win.stats.contact_phases >= 20
+    assert len(win.impacts) == len(full.impacts) == count
+    for a, b in zip(win.impacts, full.impacts, strict=True):
+        assert a.contact == b.contact
+        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-11

@@ -42,7 +42,7 @@ from reference.trajectory import Status, Trajectory
 
 from ..metrics import evaluate
 from ..progress import progress_bar
-from ..simulators import check_engine, engine_names, is_fixed_step, run_simulator
+from ..simulators import check_engine, check_run, engine_names, is_fixed_step, run_simulator
 from ..text import table
 
 DEFAULT_DTS = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6)
@@ -230,19 +230,6 @@ def bench(
             bar.update()
             return row
 
-        def skip(engine: str, dt: float, predicted: float) -> None:
-            skipped.append(
-                {
-                    "engine": engine,
-                    "setting": f"dt={dt:g}",
-                    "dt": dt,
-                    "predicted_wall_time_s": predicted,
-                    "reason": f"predicted {repeats} x {predicted:.3g} s > budget {budget_s:g} s",
-                }
-            )
-            say(f"bench: {engine} dt={dt:g}: skipped ({predicted:.3g} s predicted)")
-            bar.update()
-
         for engine in plan:
             if engine == "reference":
                 for rc in ref_settings:
@@ -252,8 +239,11 @@ def bench(
                 timed(setting, scene, horizon)  # warm-up (e.g. numba compilation)
                 measured_once(setting)
             else:
-                timed(Setting(engine, dt=dts[0]), scene, horizon)  # warm-up
-                _sweep_timesteps(engine, dts, measured_once, skip, repeats, budget_s)
+                before = len(skipped)
+                _fixed_step_sweep(
+                    engine, scene, dts, horizon, repeats, budget_s, measured_once, skipped, say
+                )
+                bar.update(len(skipped) - before)
         if "reference" not in engines:  # the truth setting is always timed
             measured_once(truth_setting)
 
@@ -293,18 +283,73 @@ def bench(
     return doc
 
 
-def _sweep_timesteps(engine, dts, measure, skip, repeats: int, budget_s: float) -> None:
-    """A fixed-step engine from the coarsest dt to the finest: each setting predicted from
-    the ones measured (`predict_time`); once `repeats` × the prediction exceeds the
-    budget, that dt and every finer one are skipped."""
+def _fixed_step_sweep(
+    engine: str,
+    scene: Scene,
+    dts: list[float],
+    horizon: float,
+    repeats: int,
+    budget_s: float,
+    measure: Callable[[Setting], dict[str, Any]],
+    skipped: list[dict[str, Any]],
+    say: Callable[[str], None],
+) -> None:
+    """A fixed-step engine over the timesteps, coarse to fine: one warm-up run, then
+    `measure` each runnable timestep until the predicted cost exceeds the budget (the
+    rest go to `skipped` with their predicted cost)."""
+    runnable = _runnable_dts(engine, scene, dts, horizon, skipped, say)
+    if runnable:
+        timed(Setting(engine, dt=runnable[0]), scene, horizon)  # warm-up
     measured: list[tuple[float, float]] = []
-    for i, dt in enumerate(dts):
-        if measured and repeats * predict_time(measured, dt) > budget_s:
-            for dt_skip in dts[i:]:
-                skip(engine, dt_skip, predict_time(measured, dt_skip))
-            return
+    for i, dt in enumerate(runnable):
+        if measured:
+            predicted = predict_time(measured, dt)
+            if repeats * predicted > budget_s:
+                for dt_skip in runnable[i:]:
+                    p = predict_time(measured, dt_skip)
+                    skipped.append(
+                        {
+                            "engine": engine,
+                            "setting": f"dt={dt_skip:g}",
+                            "dt": dt_skip,
+                            "predicted_wall_time_s": p,
+                            "reason": f"predicted {repeats} x {p:.3g} s > budget {budget_s:g} s",
+                        }
+                    )
+                    say(f"bench: {engine} dt={dt_skip:g}: skipped ({p:.3g} s predicted)")
+                break
         row = measure(Setting(engine, dt=dt))
         measured.append((dt, row["wall_time_s"]))
+
+
+def _runnable_dts(
+    engine: str,
+    scene: Scene,
+    dts: list[float],
+    horizon: float,
+    skipped: list[dict[str, Any]],
+    say: Callable[[str], None],
+) -> list[float]:
+    """The timesteps the engine can run to `horizon` (harness.simulators.check_run: at
+    most t_end, within the step ceiling); the others go to `skipped` with the reason."""
+    out = []
+    for dt in dts:
+        try:
+            check_run(engine, scene, dt, horizon)
+        except SceneError as exc:
+            skipped.append(
+                {
+                    "engine": engine,
+                    "setting": f"dt={dt:g}",
+                    "dt": dt,
+                    "predicted_wall_time_s": None,
+                    "reason": str(exc),
+                }
+            )
+            say(f"bench: {engine} dt={dt:g}: skipped ({exc})")
+        else:
+            out.append(dt)
+    return out
 
 
 def _ordered(engines: list[str]) -> list[str]:

@@ -2,12 +2,13 @@
 
 One module per command: `register` adds its parser, `run` executes it.
 
-Quiet by default: results on stdout, warnings on stderr; -v/--verbose (before or after
-the command) adds progress and diagnostics on stderr.
-
-Exit status: 0 done (also when the physics ends undecidable), 2 bad input (one line on
-stderr), 1 internal failure.  With --json exactly one JSON document goes to stdout;
-progress and logs go to stderr.
+Exit status: 0 done (also when the physics ends undecidable, or the simulator failed:
+the status says so), 2 bad input (one line on stderr: a scene, an argument or an output
+path), 1 internal failure (a traceback), 130 stopped by Ctrl-C.  With --json exactly one
+JSON document goes to stdout; progress and logs go to stderr.  Quiet by default:
+results on stdout, warnings on stderr; -v/--verbose (before or after the command) adds
+progress and diagnostics on stderr.  docs/inputs.md lists the
+accepted ranges.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import traceback
 
 from reference.scene import SceneError
 
+from ..outputs import OutputError
 from . import (
     analyze,
     bench,
@@ -76,9 +78,11 @@ def main(argv: list[str] | None = None) -> int:
         args.argv = argv  # the exact command, for the results' provenance
         configure_logging(args.verbose)
         return args.func(args)
-    except (BadInput, SceneError) as exc:
-        print(f"harness: error: {exc}", file=sys.stderr)
+    except (BadInput, SceneError, OutputError) as exc:
+        print(f"harness: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
+    except SystemExit as exc:  # --help, --version: argparse exits
+        return exc.code if isinstance(exc.code, int) else 0
     except KeyboardInterrupt:
         print("harness: interrupted", file=sys.stderr)
         return 130
@@ -88,6 +92,11 @@ def main(argv: list[str] | None = None) -> int:
         traceback.print_exc()
         print("harness: internal failure (traceback above)", file=sys.stderr)
         return 1
+
+
+def one_line(text: str) -> str:
+    """A message as one line (a TOML error may quote the offending line)."""
+    return " ".join(text.split())
 
 
 if __name__ == "__main__":

@@ -1,68 +1,238 @@
-"""What every command shares: argument types, JSON/text output, stderr logging."""
+"""What every command shares: the parser, argument types with their ranges, the options
+several commands take, JSON/text output, stderr logging and progress.
+
+Numbers on the command line are checked here, at the edge, against the same ranges as
+scene files (reference.scene; docs/inputs.md): a bad value is one line and exit status 2
+before any work starts.
+"""
 
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import math
+import re
 import sys
+import textwrap
+import time
 from typing import Any
 
+from reference.scene import DIMENSION_RANGE, GYRATION_RANGE, MAX_VERTICES, SCALE_RANGE
+
+from ..io import json_safe, json_text  # noqa: F401 (json_text re-exported)
 from ..progress import LOGGERS  # ours: INFO with -v/--verbose
+
+# A number that starts with '-' (also -1e-3, -.5, -inf, -nan): argparse must read it as a
+# value, never as an option.  argparse decides with its parser attribute
+# `_negative_number_matcher` (Python 3.11: only '-1' and '-1.5'; 3.12+: anything starting
+# '-.d' or '-d'); setting it to this pattern gives every version the same behaviour, and
+# tests/test_cli_inputs.py checks `--dt -1e-3` gives "must be > 0".
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.I)
 
 
 class BadInput(Exception):
     """Raised for user errors: printed as one line, exit status 2."""
 
 
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Options' help with their default appended (when there is a meaningful one);
+    description and epilog printed as given (Parser wraps the description)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if (
+            "%(default)" not in text
+            and action.option_strings
+            and not any(default is x for x in (None, False, argparse.SUPPRESS))
+            and not isinstance(default, list)
+        ):
+            text += " (default: %(default)s)"
+        return text
+
+
 class Parser(argparse.ArgumentParser):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        if kwargs.get("description"):  # wrapped here: the epilog (legends) stays as written
+            kwargs["description"] = textwrap.fill(" ".join(kwargs["description"].split()), 88)
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
     def error(self, message: str) -> None:  # one clear line, exit 2
         raise BadInput(f"{self.prog}: {message}")
 
 
-def positive_float(text: str) -> float:
+# ----------------------------------------------------------------------------- types
+
+
+def _float(text: str) -> float:
     try:
-        x = float(text)
+        return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+
+
+def positive_float(text: str) -> float:
+    x = _float(text)
     if not (math.isfinite(x) and x > 0):
         raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
     return x
 
 
+def float_in(lo: float, hi: float, what: str = "a number"):
+    """An argparse type: a finite float in [lo, hi]."""
+
+    def parse(text: str) -> float:
+        x = _float(text)
+        if lo > 0 and not x > 0:
+            raise argparse.ArgumentTypeError(f"must be > 0, got {text!r}")
+        if not (math.isfinite(x) and lo <= x <= hi):
+            raise argparse.ArgumentTypeError(f"must be {what} in [{lo:g}, {hi:g}], got {text!r}")
+        return x
+
+    parse.__name__ = what
+    return parse
+
+
+def int_in(lo: int, hi: int):
+    """An argparse type: an integer in [lo, hi] ('2e7' is read as 20000000)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            x = _float(text)
+            if not (math.isfinite(x) and x == int(x)):
+                raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+            value = int(x)
+        if not lo <= value <= hi:
+            raise argparse.ArgumentTypeError(f"must be an integer in [{lo}, {hi}], got {text!r}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
 def fraction(text: str) -> float:
-    try:
-        x = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    x = _float(text)
     if not (math.isfinite(x) and 0 <= x <= 1):
         raise argparse.ArgumentTypeError(f"must be in [0, 1], got {text!r}")
     return x
 
 
+# the command line's quantities, with the ranges of reference.scene
+duration = float_in(*DIMENSION_RANGE, what="a duration [s]")
+timestep = float_in(*DIMENSION_RANGE, what="a timestep [s]")
+scale = float_in(*SCALE_RANGE, what="a scale factor")
+gyration = float_in(*GYRATION_RANGE, what="a radius of gyration")
+vertices = int_in(2, MAX_VERTICES)
+budget = float_in(1e-3, 1e7, what="a time budget [s]")
+# the largest K of a sweep's A:B:K (one axis); the runs of a sweep are capped as well
+MAX_GRID_POINTS = 10_000
+
+
 def grid(text: str) -> tuple[float, float, int]:
-    """A:B:K, K values from A to B inclusive."""
+    """A:B:K, K values from A to B inclusive (a single number A: A alone)."""
     parts = text.split(":")
     try:
         if len(parts) == 1:
             a = float(parts[0])
-            return a, a, 1
-        if len(parts) != 3:
+            a_b_k = (a, a, 1)
+        elif len(parts) == 3:
+            a_b_k = (float(parts[0]), float(parts[1]), int(parts[2]))
+        else:
             raise ValueError
-        a, b, k = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected A:B:K, got {text!r}") from None
-    if k < 1 or not (math.isfinite(a) and math.isfinite(b)):
-        raise argparse.ArgumentTypeError(f"expected A:B:K with K >= 1, got {text!r}")
-    return a, b, k
+        raise argparse.ArgumentTypeError(f"expected A:B:K (K an integer), got {text!r}") from None
+    a, b, k = a_b_k
+    if not (math.isfinite(a) and math.isfinite(b)):
+        raise argparse.ArgumentTypeError(f"A and B must be finite, got {text!r}")
+    if not 1 <= k <= MAX_GRID_POINTS:
+        raise argparse.ArgumentTypeError(f"K must be in [1, {MAX_GRID_POINTS}], got {text!r}")
+    return a_b_k
+
+
+# ----------------------------------------------------------------------------- options
+
+
+def add_scene(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scene", help="a scene file (TOML) or the name of a built-in scene")
+
+
+def add_json(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--json", action="store_true", help="print exactly one JSON document on stdout")
+
+
+def add_force(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace output files that exist (never an input file)",
+    )
+
+
+def add_t_end(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--t-end",
+        type=duration,
+        metavar="T",
+        help="simulated time [s], in [1e-50, 1e50] (default: the scene's run.t_end)",
+    )
+
+
+def add_engine(p: argparse.ArgumentParser, many: str | None = None, **kw: Any) -> None:
+    """--engine E; `many`: it may be repeated, and what happens without it."""
+    text = "simulator: reference, linear, mujoco, pybullet, ... (`harness engines` lists them)"
+    if many is not None:
+        kw.setdefault("action", "append")
+        text += f"; repeat for several ({many})"
+    else:
+        kw.setdefault("default", "reference")
+    p.add_argument("--engine", metavar="E", help=text, **kw)
+
+
+def add_dt(p: argparse.ArgumentParser, many: str | None = None) -> None:
+    """--dt DT; `many`: it may be repeated, and what happens without it."""
+    text = "timestep of fixed-step engines [s], > 0 and <= t_end; event-driven simulators "
+    if many is not None:
+        text += f"ignore it; repeat for several ({many})"
+        p.add_argument("--dt", type=timestep, metavar="DT", action="append", help=text)
+    else:
+        text += "ignore it (default: 1e-4)"
+        p.add_argument("--dt", type=timestep, metavar="DT", help=text)
+
+
+def add_scale(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--scale",
+        type=scale,
+        metavar="EPS",
+        help="scale the linear initial coordinates, q by EPS^2 and p by EPS (scenes "
+        "given by q and p; EPS in [1e-50, 1e50])",
+    )
+
+
+def add_max_steps(p: argparse.ArgumentParser) -> None:
+    from ..simulators import DEFAULT_MAX_STEPS
+
+    p.add_argument(
+        "--max-steps",
+        type=int_in(1, 10**12),
+        default=DEFAULT_MAX_STEPS,
+        metavar="N",
+        help="most steps a fixed-step engine may take (t_end / dt); a longer run is "
+        "refused before it starts",
+    )
+
+
+# ----------------------------------------------------------------------------- output
 
 
 def emit(doc: Any, as_json: bool, text: str) -> None:
     """Exactly one JSON document on stdout with --json, else the text."""
     if as_json:
-        json.dump(finite(doc), sys.stdout, indent=None, allow_nan=False)
-        sys.stdout.write("\n")
+        sys.stdout.write(json_text(doc) + "\n")
     else:
         print(text)
 
@@ -102,28 +272,59 @@ def add_verbose(parser: argparse.ArgumentParser, top: bool = False) -> None:
     )
 
 
-def finite(x: Any) -> Any:
-    """JSON has no NaN/inf: map them to null (numpy scalars and arrays to Python)."""
-    import numpy as np
+# JSON has no NaN/inf: the one mapping lives in harness.io
+finite = json_safe
 
-    if isinstance(x, dict):
-        return {k: finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [finite(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return finite(x.tolist())
-    if isinstance(x, (np.floating, np.integer, np.bool_)):
-        x = x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
+
+class StepProgress:
+    """`progress(done, total)` for long fixed-step runs: a tqdm bar on stderr, shown at
+    once when stderr is a terminal, else only once the run has taken LONG_RUN_S (then
+    refreshed every 10 s, so that logs stay short)."""
+
+    LONG_RUN_S = 5.0
+
+    def __init__(self, label: str) -> None:
+        self.label = label
+        self.start = time.perf_counter()
+        self.bar = None
+
+    def __call__(self, done: int, total: int) -> None:
+        tty = sys.stderr.isatty()
+        if self.bar is None:
+            if not tty and time.perf_counter() - self.start < self.LONG_RUN_S:
+                return
+            from tqdm import tqdm
+
+            self.bar = tqdm(
+                total=total,
+                desc=self.label,
+                unit="step",
+                unit_scale=True,
+                file=sys.stderr,
+                mininterval=0.5 if tty else 10.0,
+                dynamic_ncols=True,
+            )
+        self.bar.update(done - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def load_scene_arg(args):
-    """The SCENE argument (a file or a built-in name), with --scale applied."""
+    """The SCENE argument (a file or a built-in name), with --scale applied (the scaled
+    scene passes the same checks as a scene file, below-ground included)."""
     from ..scenes import resolve_scene
 
     scene = resolve_scene(args.scene)
     if getattr(args, "scale", None) is not None:
         scene = scene.scaled(args.scale)
     return scene
+
+
+def scene_inputs(args) -> list:
+    """The file the SCENE argument names (to keep outputs off it), if any."""
+    from ..scenes import scene_file
+
+    path = scene_file(args.scene)
+    return [path] if path is not None else []

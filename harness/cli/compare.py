@@ -2,17 +2,42 @@
 
 from __future__ import annotations
 
-from .common import BadInput, emit, load_scene_arg, log, note, positive_float
+from .common import (
+    add_dt,
+    add_engine,
+    add_force,
+    add_json,
+    add_max_steps,
+    add_scale,
+    add_scene,
+    add_t_end,
+    emit,
+    load_scene_arg,
+    log,
+    note,
+    scene_inputs,
+)
 
 
 def register(sub) -> None:
-    c = sub.add_parser("compare", help="reference against the named simulators")
-    c.add_argument("scene")
-    c.add_argument("--engine", action="append", required=True)
-    c.add_argument("--dt", type=positive_float, action="append")
-    c.add_argument("--t-end", type=positive_float)
-    c.add_argument("--scale", type=positive_float)
-    c.add_argument("--record", metavar="FILE.rrd")
+    c = sub.add_parser(
+        "compare",
+        help="reference against the named simulators",
+        description="The exact reference against the named simulators on one scene: "
+        "impacts matched, impact-time, energy and attitude errors.  Ctrl-C stops it "
+        "(exit status 130).",
+    )
+    add_scene(c)
+    add_engine(c, many="at least one", required=True)
+    add_dt(c, many="default: 1e-4")
+    add_t_end(c)
+    add_scale(c)
+    add_max_steps(c)
+    c.add_argument(
+        "--record",
+        metavar="FILE.rrd",
+        help="also write a rerun recording of all runs (a bare file name goes under recordings/)",
+    )
     c.add_argument(
         "--wide",
         action="store_true",
@@ -23,41 +48,47 @@ def register(sub) -> None:
         metavar="FILE",
         help="write the impact-by-impact diff to FILE (.csv or .parquet; docs/output.md)",
     )
-    c.add_argument("--force", action="store_true", help="let --out replace an existing file")
-    c.add_argument("--json", action="store_true")
+    add_force(c)
+    add_json(c)
     c.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..compare import compare, format_compare
+    from ..outputs import check_distinct, check_writable
     from ..provenance import attach
-    from ..simulators import check_engine
+    from ..simulators import check_engine, check_run
 
     for e in args.engine:
         check_engine(e)
-    if args.out:
+    if args.out:  # before minutes of simulation, not after
         from ..io import check_table_path
 
-        try:  # before minutes of simulation, not after
-            check_table_path(args.out, args.force)
-        except ValueError as exc:
-            raise BadInput(str(exc)) from None
+        check_table_path(args.out, args.force, scene_inputs(args))
     scene = load_scene_arg(args)
-    result = compare(scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log)
+    for e in args.engine:
+        for dt in args.dt or [None]:
+            check_run(e, scene, dt, args.t_end, args.max_steps)
+    check_run("reference", scene, None, args.t_end)
+    if args.record:
+        from ..recording import recording_path
+
+        check_writable(recording_path(args.record), args.force, scene_inputs(args))
+        check_distinct([recording_path(args.record), args.out])
     recording = None
+    result = compare(
+        scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log, max_steps=args.max_steps
+    )
     if args.record:
         from ..recording import record_comparison
 
-        recording = record_comparison(result, args.record, note=note)
+        recording = record_comparison(result, args.record, note=note, force=args.force)
         note(f"wrote {recording}")
     if args.out:
         from ..compare.diff import impact_diff
         from ..io import write_table
 
-        try:
-            path = write_table(impact_diff(result), args.out, force=args.force)
-        except ValueError as exc:
-            raise BadInput(str(exc)) from None
+        path = write_table(impact_diff(result), args.out, force=args.force)
         note(f"wrote {path}")
     doc = result.to_dict()
     if recording is not None:

@@ -8,12 +8,12 @@ named with the reason on stderr; the others are still listed).
 
 from __future__ import annotations
 
-from .common import emit, note
+from .common import add_json, emit, note
 
 
 def register(sub) -> None:
     e = sub.add_parser("engines", help="installed engines (entry points harness.engines)")
-    e.add_argument("--json", action="store_true")
+    add_json(e)
     e.set_defaults(func=run)
 
 

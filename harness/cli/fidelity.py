@@ -2,9 +2,20 @@
 
 from __future__ import annotations
 
-import json
-
-from .common import BadInput, emit, finite, fraction, grid, log, note, positive_float
+from .common import (
+    add_dt,
+    add_engine,
+    add_force,
+    add_json,
+    emit,
+    fraction,
+    grid,
+    int_in,
+    log,
+    note,
+    positive_float,
+    scene_inputs,
+)
 
 
 def register(sub) -> None:
@@ -16,10 +27,8 @@ def register(sub) -> None:
         help="smallest inclination alpha* each engine follows, against dt (docs/fidelity.md)",
     )
     f.add_argument("scene", help="a built-in scene or a file, given in (q, p)")
-    f.add_argument(
-        "--engine", action="append", help="default: every installed engine but reference, linear"
-    )
-    f.add_argument("--dt", type=positive_float, action="append", help="default 1e-3, 1e-4, 1e-5")
+    add_engine(f, many="default: every installed engine but reference and linear")
+    add_dt(f, many="default: 1e-3, 1e-4, 1e-5")
     a, b, k = DEFAULT_EPS_GRID
     f.add_argument(
         "--eps-grid",
@@ -30,7 +39,7 @@ def register(sub) -> None:
     )
     f.add_argument(
         "--leading",
-        type=int,
+        type=int_in(1, 10**6),
         default=DEFAULT_LEADING,
         help=f"leading impacts of the reference to match (default {DEFAULT_LEADING})",
     )
@@ -60,26 +69,20 @@ def register(sub) -> None:
     )
     f.add_argument("--plot", metavar="FILE.png", help="alpha* against dt with the fitted k")
     f.add_argument("--out", metavar="FILE.json", help="also write the JSON document here")
-    f.add_argument("--force", action="store_true", help="let --out/--plot replace a file")
-    f.add_argument("--json", action="store_true")
+    add_force(f)
+    add_json(f)
     f.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..fidelity import FidelityCriteria, eps_values, fidelity, format_fidelity
     from ..provenance import attach
-    from ..result_files import check_result_path, write_result_text
     from ..simulators import check_engine
     from .common import load_scene_arg
 
     for e in args.engine or []:
         check_engine(e)
-    try:  # before the runs, not after
-        for path, suffix in ((args.out, ".json"), (args.plot, ".png")):
-            if path:
-                check_result_path(path, (suffix,), args.force)
-    except ValueError as exc:
-        raise BadInput(str(exc)) from None
+    check_outputs(args)  # before the runs, not after
     scene = load_scene_arg(args)
     scene.scaled(1.0)  # a scene not given in (q, p) is bad input now, not after the reference
     criteria = FidelityCriteria(args.leading, args.match_fraction, args.c_tolerance)
@@ -94,17 +97,34 @@ def run(args) -> int:
         progress=log,
     )
     attach(doc, args)
-    if args.plot:
-        from ..fidelity import alpha_star_figure, save_figure
-        from ..result_files import write_result_atomic
-
-        path = check_result_path(args.plot, (".png",), args.force)
-        fig = alpha_star_figure(doc)
-        write_result_atomic(path, lambda tmp: save_figure(fig, tmp), args.force)
-        doc["plot"] = str(path)
-        note(f"wrote {path}")
-    if args.out:
-        write_result_text(json.dumps(finite(doc), indent=1), args.out, (".json",), args.force)
-        note(f"wrote {args.out}")
+    write_outputs(args, doc)
     emit(doc, args.json, format_fidelity(doc))
     return 0
+
+
+def check_outputs(args) -> None:
+    from ..outputs import check_distinct, check_writable
+
+    check_distinct([args.out, args.plot])
+    inputs = scene_inputs(args)
+    if args.out:
+        check_writable(args.out, args.force, inputs, what="--out", suffixes=(".json",))
+    if args.plot:
+        check_writable(args.plot, args.force, inputs, what="--plot", suffixes=(".png",))
+
+
+def write_outputs(args, doc: dict) -> None:
+    from ..io import json_text
+    from ..outputs import atomic_write, write_text
+
+    if args.plot:
+        from ..fidelity import alpha_star_figure, save_figure
+
+        fig = alpha_star_figure(doc)
+        with atomic_write(args.plot, args.force) as tmp:
+            save_figure(fig, tmp)
+        doc["plot"] = str(args.plot)
+        note(f"wrote {args.plot}")
+    if args.out:
+        write_text(args.out, json_text(doc, indent=1), args.force)
+        note(f"wrote {args.out}")

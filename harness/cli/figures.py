@@ -2,21 +2,46 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
-from .common import emit, log
+from .common import BadInput, add_force, add_json, emit, log
 
 
 def register(sub) -> None:
-    f = sub.add_parser("figures", help="the paper's figures as PNGs")
-    f.add_argument("--out", default="figures")
-    f.add_argument("--json", action="store_true")
+    f = sub.add_parser(
+        "figures",
+        help="the paper's figures as PNGs",
+        description="Recompute the paper's figures from the linearised model and save them "
+        "as PNGs in a folder, each with what the paper states and what we measured.",
+    )
+    f.add_argument(
+        "--out",
+        default="figures",
+        metavar="DIR",
+        help="folder for the PNGs (created if missing; files there are replaced only with --force)",
+    )
+    add_force(f)
+    add_json(f)
     f.set_defaults(func=run)
+
+
+def check_out(out: Path, force: bool) -> None:
+    """DIR is a folder (or will be one) and every figure in it may be written."""
+    from ..figures import figure_paths
+    from ..outputs import check_writable, show
+
+    if os.path.lexists(out) and not os.path.isdir(out):
+        raise BadInput(f"--out {show(out)} is not a directory")
+    for path in figure_paths(out):
+        check_writable(path, force=force)
 
 
 def run(args) -> int:
     from ..figures import format_figures, make_figures
 
-    doc = make_figures(Path(args.out), progress=log)
-    emit(doc, args.json, format_figures(doc, Path(args.out)))
+    out = Path(args.out)
+    check_out(out, args.force)
+    doc = make_figures(out, progress=log)
+    emit(doc, args.json, format_figures(doc, out))
     return 0

@@ -3,7 +3,9 @@ sweep results (docs/report.md)."""
 
 from __future__ import annotations
 
-from .common import BadInput, note
+from .common import BadInput, add_force, note
+
+HTML = (".html", ".htm")
 
 
 def register(sub) -> None:
@@ -16,26 +18,24 @@ def register(sub) -> None:
         metavar="INPUT",
         help="JSON of compare/bench/fidelity/stress/sweep, or a sweep directory",
     )
-    r.add_argument("--out", required=True, metavar="FILE.html")
-    r.add_argument("--force", action="store_true", help="replace an existing FILE.html")
+    r.add_argument(
+        "--out", required=True, metavar="FILE.html", help="the HTML file to write (.html)"
+    )
+    add_force(r)
     r.set_defaults(func=run)
 
 
 def run(args) -> int:
+    from ..outputs import check_writable, write_text
     from ..provenance import provenance
     from ..report import ReportInputError, build_report, load_inputs
-    from ..result_files import check_result_path, write_result_text
 
-    suffixes = (".html", ".htm")
+    check_writable(args.out, args.force, args.inputs, what="report", suffixes=HTML)
     try:
-        check_result_path(args.out, suffixes, args.force)
         items = [item for path in args.inputs for item in load_inputs(path)]
-    except (ValueError, ReportInputError) as exc:
+    except ReportInputError as exc:
         raise BadInput(str(exc)) from None
     html = build_report(items, args.out, provenance(getattr(args, "argv", None)))
-    try:
-        path = write_result_text(html, args.out, suffixes, args.force)
-    except ValueError as exc:
-        raise BadInput(str(exc)) from None
+    path = write_text(args.out, html, args.force)
     note(f"wrote {path} ({len(html) / 1024:.0f} KiB, {len(items)} result(s))")
     return 0

@@ -4,7 +4,11 @@ from __future__ import annotations
 
 
 def register(sub) -> None:
-    sub.add_parser("scenes", help="list built-in scenes").set_defaults(func=run)
+    sub.add_parser(
+        "scenes",
+        help="list built-in scenes",
+        description="The built-in scenes (usable by name as SCENE), one line each.",
+    ).set_defaults(func=run)
 
 
 def run(args) -> int:

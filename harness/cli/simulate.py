@@ -2,38 +2,114 @@
 
 from __future__ import annotations
 
-from .common import emit, load_scene_arg, note, positive_float
+from .common import (
+    StepProgress,
+    add_dt,
+    add_engine,
+    add_force,
+    add_json,
+    add_max_steps,
+    add_scale,
+    add_scene,
+    add_t_end,
+    emit,
+    load_scene_arg,
+    note,
+    scene_inputs,
+)
+
+# exit status of a run stopped by Ctrl-C (128 + SIGINT, the shell's convention)
+INTERRUPTED = 130
 
 
 def register(sub) -> None:
-    s = sub.add_parser("simulate", help="one run of one simulator")
-    s.add_argument("scene")
-    s.add_argument("--engine", default="reference")
-    s.add_argument("--dt", type=positive_float)
-    s.add_argument("--t-end", type=positive_float)
-    s.add_argument("--scale", type=positive_float)
-    s.add_argument("--record", metavar="FILE.rrd")
-    s.add_argument("--out", metavar="FILE.parquet")
-    s.add_argument("--json", action="store_true")
+    s = sub.add_parser(
+        "simulate",
+        help="one run of one simulator",
+        description="One run of one simulator on one scene.  Prints the run's summary "
+        "(status, impacts, energy, final state).  Exit status 0 done (whatever the "
+        "physics), 2 bad input, 130 stopped by Ctrl-C (the summary of the part computed "
+        "is printed, no file is written).",
+    )
+    add_scene(s)
+    add_engine(s)
+    add_dt(s)
+    add_t_end(s)
+    add_scale(s)
+    add_max_steps(s)
+    s.add_argument(
+        "--record",
+        metavar="FILE.rrd",
+        help="also write a rerun recording (a bare file name goes under recordings/)",
+    )
+    s.add_argument(
+        "--out",
+        metavar="FILE.parquet",
+        help="also write the samples to FILE and the impacts to FILE with .impacts "
+        "before its suffix (Parquet; the summary in the schema metadata)",
+    )
+    add_force(s)
+    add_json(s)
     s.set_defaults(func=run)
 
 
+def planned_outputs(args) -> list:
+    """The files this run will write, as harness.outputs sees them."""
+    from ..io import trajectory_paths
+    from ..recording import recording_path
+
+    paths = trajectory_paths(args.out) if args.out else []
+    if args.record:
+        paths.append(recording_path(args.record))
+    return paths
+
+
+def check_outputs(args, paths) -> None:
+    from ..outputs import check_distinct, check_writable
+
+    check_distinct(paths)
+    inputs = scene_inputs(args)
+    for path in paths:
+        check_writable(path, force=args.force, inputs=inputs)
+
+
 def run(args) -> int:
-    from ..simulators import check_engine, run_simulator
+    from ..simulators import check_engine, check_run, run_simulator
     from ..text import format_simulate
 
     check_engine(args.engine)
     scene = load_scene_arg(args)
-    traj = run_simulator(args.engine, scene, dt=args.dt, t_end=args.t_end)
+    check_run(args.engine, scene, args.dt, args.t_end, args.max_steps)
+    check_outputs(args, planned_outputs(args))
+    progress = StepProgress(args.engine)
+    try:
+        traj = run_simulator(
+            args.engine,
+            scene,
+            dt=args.dt,
+            t_end=args.t_end,
+            max_steps=args.max_steps,
+            progress=progress,
+        )
+    finally:
+        progress.close()
+    interrupted = bool(traj.stats.get("interrupted"))
+    if interrupted:
+        note("harness: interrupted; the summary covers the part computed, no file written")
+    else:
+        write_outputs(args, traj, scene)
+    emit(traj.summary(with_impacts=True), args.json, format_simulate(traj))
+    return INTERRUPTED if interrupted else 0
+
+
+def write_outputs(args, traj, scene) -> None:
     if args.out:
         from ..io import write_trajectory_parquet
 
-        write_trajectory_parquet(traj, args.out)
+        write_trajectory_parquet(traj, args.out, force=args.force)
         note(f"wrote {args.out}")
     if args.record:
         from ..recording import record_trajectories
 
-        path = record_trajectories([traj], args.record, scene=scene)
+        path = record_trajectories([traj], args.record, scene=scene, force=args.force)
         note(f"wrote {path}")
-    emit(traj.summary(with_impacts=True), args.json, format_simulate(traj))
-    return 0

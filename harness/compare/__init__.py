@@ -112,11 +112,13 @@ def compare(
     dts: list[float] | None = None,
     t_end: float | None = None,
     progress: Callable[[str], None] | None = None,
+    max_steps: int | None = None,
 ) -> CompareResult:
     """Run the reference once and each engine at each dt (DEFAULT_DT when `dts` is None;
     once for `reference` and `linear`), all to the same t_end, and score every run.
     Each simulator is warmed up before it is timed.  `progress` gets one line per run
-    with its wall time (for stderr)."""
+    with its wall time (for stderr).  An engine run stopped by Ctrl-C stops the
+    comparison (KeyboardInterrupt)."""
     say = progress or (lambda _msg: None)
     dts = list(dts) if dts else [DEFAULT_DT]
     plan = [(e, dt) for e in engines for dt in (dts if is_fixed_step(e) else [None])]
@@ -131,7 +133,7 @@ def compare(
             if engine == "reference":
                 traj, wall = reference, ref_wall
             else:
-                traj, wall = _timed_run(engine, scene, dt, t_end)
+                traj, wall = _timed_run(engine, scene, dt, t_end, max_steps=max_steps)
                 say(_progress_line(engine, dt, traj, wall))
             metrics = evaluate(traj, reference, scene.gravity)
             fit = run_exponent(traj, scene, reference, metrics.match)
@@ -141,14 +143,21 @@ def compare(
 
 
 def _timed_run(
-    engine: str, scene: Scene, dt: float | None, t_end: float | None, reraise: bool = False
+    engine: str,
+    scene: Scene,
+    dt: float | None,
+    t_end: float | None,
+    reraise: bool = False,
+    max_steps: int | None = None,
 ) -> tuple[Trajectory, float]:
     """The run and its wall time, after a warm-up (simulators.warm_up) so that the time
     is the simulation's, not one-time imports or compilation."""
     warm_up(engine, scene, dt)
     start = time.perf_counter()
     try:
-        traj = run_simulator(engine, scene, dt=dt, t_end=t_end)
+        traj = run_simulator(engine, scene, dt=dt, t_end=t_end, max_steps=max_steps)
+        if traj.stats.get("interrupted"):
+            raise KeyboardInterrupt
     except SceneError:
         raise
     except Exception as exc:  # an engine that breaks is a result, not a crash

@@ -226,6 +226,9 @@ def engine_row(
         row["skipped"] = blocked
         return row
     scene = case.scene.with_run(t_end=t_run)
+    if dt is not None and dt > t_run:  # not one step fits: it cannot follow any impact
+        why = f"dt = {dt:g} s is longer than the whole run at this scale ({t_run:.3g} s)"
+        return {**row, **score(Trajectory.failed(engine, scene.name, dt, why), case, criteria)}
     predicted = predict_run_time(engine, scene, dt, row["steps"], measured)
     row["predicted_wall_time_s"] = predicted
     if predicted is not None and predicted > budget_s:

@@ -25,6 +25,8 @@ from reference.linear.model import LinearModel
 from reference.linear.selfsimilar import selfsimilar_solutions
 from reference.linear.simulate import run_linear, run_linear_exponent
 
+from ..outputs import atomic_write
+
 # Axis labels.  The models are dimensionless with a = m = g = 1: lengths in a, times in
 # √(a/g), energies in m g a; ratios carry [–].
 RHO = "ρ = radius of gyration / a  [–]"
@@ -44,10 +46,15 @@ def _plt():
 
 
 def _save(fig, path: Path, dpi: int = 120) -> Path:
-    """Write the figure (tight layout) to path and free it."""
+    """Write the figure (tight layout) to path, atomically, and free it.  Whether an
+    existing file may be replaced is decided before the figures are computed
+    (`figure_paths`, checked by the CLI with --force)."""
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
-    _plt().close(fig)
+    try:
+        with atomic_write(path, force=True) as tmp:
+            fig.savefig(tmp, dpi=dpi)
+    finally:
+        _plt().close(fig)
     return path
 
 
@@ -452,10 +459,14 @@ def format_figures(doc: dict, out_dir: Path) -> str:
     return "\n".join(lines)
 
 
+def figure_paths(out_dir: Path) -> list[Path]:
+    """The files `make_figures` writes into out_dir (each figure is saved as <name>.png)."""
+    return [Path(out_dir) / f"{name}.png" for name in FIGURES]
+
+
 def make_figures(out_dir: Path, progress=print) -> dict:
     """Compute and save every figure; returns name → {path, paper, ours, agree}."""
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = Path(out_dir)  # created with the first figure (harness.outputs)
     doc = {}
     for name, fn in FIGURES.items():
         progress(f"figure {name}")

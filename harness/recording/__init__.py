@@ -19,6 +19,7 @@ No global recording is created.
 
 from __future__ import annotations
 
+import os
 import uuid
 from collections.abc import Callable
 from pathlib import Path
@@ -29,6 +30,7 @@ import rerun as rr
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
+from ..outputs import atomic_write
 from .geometry import exaggeration_schedule
 from .layout import SUMMARY, RowRanges, build_blueprint, value_range
 from .raster import log_raster, raster_range
@@ -56,11 +58,11 @@ __all__ = [
 
 
 def recording_path(path: str | Path) -> Path:
-    """Where to write: a bare file name goes under recordings/; parent folders are created."""
+    """Where to write: a bare file name (no folder, not even ./) goes under recordings/.
+    Folders are created when the recording is written (harness.outputs.atomic_write)."""
     p = Path(path)
-    if p.parent == Path("."):
+    if "/" not in str(path) and os.sep not in str(path):
         p = DEFAULT_FOLDER / p
-    p.parent.mkdir(parents=True, exist_ok=True)
     return p
 
 
@@ -69,6 +71,7 @@ def record_trajectories(
     path: str | Path,
     scene: Scene,
     contact_tolerance: float | None = None,
+    force: bool = False,
 ) -> Path:
     """Write one `.rrd` with the trajectories side by side; the first is the reference
     (the others are matched against it, harness.metrics).  `contact_tolerance`: gap
@@ -76,13 +79,14 @@ def record_trajectories(
     Returns the path written."""
     if not trajs:
         raise ValueError("record_trajectories needs at least one trajectory")
-    return _write(build_runs(trajs, scene), scene, path, contact_tolerance)
+    return _write(build_runs(trajs, scene), scene, path, contact_tolerance, force)
 
 
 def record_comparison(
     result: CompareResult,
     path: str | Path,
     note: Callable[[str], None] | None = None,
+    force: bool = False,
 ) -> Path:
     """Write the recording of a `harness compare` result, reusing its metrics and
     exponents.  Runs without samples (failed before the first step) are left out, with
@@ -96,7 +100,7 @@ def record_comparison(
     if fits[0] is None:
         fits = None
     runs = build_runs(trajs, result.scene, metrics=metrics, fits=fits)
-    return _write(runs, result.scene, path)
+    return _write(runs, result.scene, path, force=force)
 
 
 def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
@@ -109,7 +113,11 @@ def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
 
 
 def _write(
-    runs: list[RunView], scene: Scene, path: str | Path, contact_tolerance: float | None = None
+    runs: list[RunView],
+    scene: Scene,
+    path: str | Path,
+    contact_tolerance: float | None = None,
+    force: bool = False,
 ) -> Path:
     out = recording_path(path)
     tol = 1e-6 * scene.body.radius if contact_tolerance is None else contact_tolerance
@@ -129,19 +137,20 @@ def _write(
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     if not rr.is_enabled(rec):
         raise RuntimeError("rerun logging is disabled (RERUN=off?): no recording written")
-    rec.save(out, default_blueprint=blueprint)
-    try:
-        names = ", ".join(r.label for r in runs)
-        rec.send_recording_name(f"{scene.name}: {names}")
-        for run in runs:
-            log_scene(rec, run, scene, schedule, tol)
-            log_rows(rec, run)
-        log_raster(rec, runs, n_contacts, t_max)
-        log_energy_plot(rec, runs, e_plot)
-        log_alpha_plot(rec, runs, a_plot)
-        text = summary_markdown(runs, scene, t_max)
-        rec.log(SUMMARY, rr.TextDocument(text, media_type="text/markdown"), static=True)
-    finally:
-        rec.flush()
-        rec.disconnect()  # closes the file sink: footer and manifest are written
+    with atomic_write(out, force) as tmp:
+        rec.save(tmp, default_blueprint=blueprint)
+        try:
+            names = ", ".join(r.label for r in runs)
+            rec.send_recording_name(f"{scene.name}: {names}")
+            for run in runs:
+                log_scene(rec, run, scene, schedule, tol)
+                log_rows(rec, run)
+            log_raster(rec, runs, n_contacts, t_max)
+            log_energy_plot(rec, runs, e_plot)
+            log_alpha_plot(rec, runs, a_plot)
+            text = summary_markdown(runs, scene, t_max)
+            rec.log(SUMMARY, rr.TextDocument(text, media_type="text/markdown"), static=True)
+        finally:
+            rec.flush()
+            rec.disconnect()  # closes the file sink: footer and manifest are written
     return out

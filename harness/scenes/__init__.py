@@ -5,7 +5,7 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
-from reference.scene import Scene, SceneError, load_scene
+from reference.scene import Scene, SceneError, load_scene, show_path
 
 
 def builtin_dir() -> Path:
@@ -18,15 +18,29 @@ def builtin_names() -> list[str]:
 
 def resolve_scene(arg: str) -> Scene:
     """SCENE is a path to a scene file or the name of a built-in scene."""
+    path = scene_file(arg)
+    if path is None:
+        raise SceneError(
+            f"no scene file or built-in scene named {show_path(arg)!r} "
+            f"(built-ins: {', '.join(builtin_names())})"
+        )
+    return load_scene(path)
+
+
+def scene_file(arg: str) -> Path | None:
+    """The file SCENE names: the path itself when it ends in .toml or exists, else the
+    built-in scene of that name; None when neither (a path the system refuses, e.g. one
+    too long, counts as a path: load_scene then says why it cannot be read)."""
     path = Path(arg)
-    if path.suffix == ".toml" or path.exists():
-        return load_scene(path)
-    candidate = builtin_dir() / f"{arg}.toml"
-    if candidate.is_file():
-        return load_scene(candidate)
-    raise SceneError(
-        f"no scene file or built-in scene named {arg!r} (built-ins: {', '.join(builtin_names())})"
-    )
+    try:
+        if path.suffix == ".toml" or path.exists():
+            return path
+        candidate = builtin_dir() / f"{arg}.toml"
+        if candidate.is_file():
+            return candidate
+    except (OSError, ValueError):  # name too long, a NUL character, ...
+        return path
+    return None
 
 
 def list_builtin() -> list[tuple[str, str]]:

@@ -45,7 +45,14 @@ from reference.scene import SceneError
 from reference.trajectory import Trajectory
 
 from ..progress import progress_bar
-from ..simulators import DEFAULT_DT, check_engine, engine_names, is_fixed_step, run_simulator
+from ..simulators import (
+    DEFAULT_DT,
+    check_engine,
+    check_run,
+    engine_names,
+    is_fixed_step,
+    run_simulator,
+)
 from .budget import (
     HARD_CAP_FACTOR,
     over_budget,
@@ -60,6 +67,7 @@ from .text import format_stress, num  # noqa: F401
 
 DEFAULT_BUDGET_S = 30.0  # per run
 SKIPPED = "skipped (budget)"
+NOT_RUNNABLE = "skipped (not runnable)"  # e.g. dt longer than the case (check_run says why)
 
 
 def _case_rows(case, engines, others, dt, budget_s, say, bar) -> list[dict[str, Any]]:
@@ -101,13 +109,18 @@ def _case_rows(case, engines, others, dt, budget_s, say, bar) -> list[dict[str, 
 
 
 def _skipped_row(
-    case: StressCase, engine: str, dt, predicted: float | None, reason: str
+    case: StressCase,
+    engine: str,
+    dt,
+    predicted: float | None,
+    reason: str,
+    verdict: str = SKIPPED,
 ) -> dict[str, Any]:
     return {
         "case": case.name,
         "engine": engine,
         "dt": dt,
-        "verdict": SKIPPED,
+        "verdict": verdict,
         "status": None,
         "finished": None,
         "nan": None,
@@ -134,6 +147,10 @@ def _engine_row(
     scene, t_end = case.scene, case.scene.run.t_end
     step = dt if is_fixed_step(engine) else None
     predicted = None
+    try:
+        check_run(engine, scene, step, t_end)  # e.g. dt longer than the case
+    except SceneError as exc:
+        return _skipped_row(case, engine, step, None, str(exc), verdict=NOT_RUNNABLE)
     if step is not None:
         try:
             predicted = predict_engine_time(engine, scene, step)

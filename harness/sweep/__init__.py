@@ -23,13 +23,15 @@ from pathlib import Path
 
 from reference.scene import SceneError
 
-from ..simulators import check_engine, is_fixed_step
-from .executors import ExecutorError
+from ..simulators import check_engine, check_run, is_fixed_step
+from .executors import ExecutorError, check_scheduler
 from .grid import (
     SweepConfig,
     all_keys,
+    config_problem,
     default_chunk_size,
     default_min_decades,
+    initial_state,
     make_chunks,
 )
 from .store import KEY, StoreError, SweepStore, engines_in, load_results
@@ -45,22 +47,17 @@ def _bad(msg: str) -> SweepError:
 
 
 def config_from_args(args) -> SweepConfig:
-    """Validate the CLI arguments into a SweepConfig (BadInput on nonsense)."""
+    """Validate the CLI arguments into a SweepConfig (SweepError on nonsense), before
+    anything is written: the grid (`grid.config_problem`) and one run of it
+    (harness.simulators.check_run: t_end, dt <= t_end, the step ceiling, the engine's
+    largest n)."""
     check_engine(args.engine)
-    if args.n < 2:
-        raise _bad(f"--n must be >= 2, got {args.n}")
-    if args.samples < 1:
-        raise _bad(f"--samples must be >= 1, got {args.samples}")
     if args.seed < 0:
         raise _bad(f"--seed must be >= 0, got {args.seed}")
-    for name, (a, b, _k) in (("gyration", args.gyration), ("restitution", args.restitution)):
-        if min(a, b) < 0 or (name == "restitution" and max(a, b) > 1):
-            rng = "[0, 1]" if name == "restitution" else ">= 0"
-            raise _bad(f"--{name} values must be {rng}, got {a}:{b}")
     dt = getattr(args, "dt", None)
-    t_end = getattr(args, "t_end", None)  # optional flag (not in cli.py yet)
+    t_end = getattr(args, "t_end", None)
     extra = {"t_end": float(t_end)} if t_end is not None and args.engine != "linear" else {}
-    return SweepConfig(
+    config = SweepConfig(
         n=int(args.n),
         gyration=tuple(args.gyration),
         restitution=tuple(args.restitution),
@@ -71,6 +68,23 @@ def config_from_args(args) -> SweepConfig:
         min_decades=default_min_decades(args.engine),
         **extra,
     )
+    check_config(config)
+    return config
+
+
+def check_config(config: SweepConfig) -> None:
+    """SweepError unless the sweep can run (see `config_from_args`)."""
+    from .run import polygon_scene
+
+    problem = config_problem(config)
+    if problem:
+        raise _bad(problem)
+    q0, p0 = initial_state(config.seed, 0, 0, 0)
+    scene = polygon_scene(
+        config, float(config.rho_values[0]), float(config.gamma_values[0]), q0, p0
+    )
+    t_end = None if config.engine == "linear" else config.t_end
+    check_run(config.engine, scene, config.dt, t_end)
 
 
 def run_exponent_sweep(args, progress=None) -> dict:
@@ -82,6 +96,11 @@ def run_exponent_sweep(args, progress=None) -> dict:
     workers = getattr(args, "workers", None)
     if executor == "dask" and not scheduler:
         raise _bad("--executor dask needs --scheduler ADDR (e.g. tcp://127.0.0.1:8786)")
+    if executor == "dask":
+        try:
+            check_scheduler(scheduler)
+        except ExecutorError as exc:
+            raise _bad(str(exc)) from None
     if workers is not None and workers < 1:
         raise _bad(f"--workers must be >= 1, got {workers}")
     chunk_size = getattr(args, "chunk_size", None)  # optional flag (not in cli.py yet)
@@ -127,10 +146,13 @@ def exponent_sweep(
     t0 = time.perf_counter()
     load_start = os.getloadavg()
     root = Path(out)
+    check_config(config)  # before the manifest is written
     store = SweepStore(root, config).open()
+    for note in store.notes:
+        say(f"sweep: {note}")
     statuses: dict[str, int] = {}
     try:
-        done_df, _ = load_results(store.dir)
+        done_df, _ = store.results
         done = set(zip(*(done_df[k].tolist() for k in KEY), strict=True)) if len(done_df) else set()
         missing = [k for k in all_keys(config) if k not in done]
         chunk_size = chunk_size or default_chunk_size(config.engine)

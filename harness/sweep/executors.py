@@ -122,6 +122,29 @@ def run_local(
         pool.shutdown(wait=False, cancel_futures=True)
 
 
+def check_scheduler(scheduler: str, timeout_s: float = 5.0) -> None:
+    """ExecutorError unless the scheduler address is tcp://HOST:PORT (or HOST:PORT) and
+    accepts a connection: checked before the sweep writes anything, so that a wrong
+    address is one line and nothing else.  (The CLI gives no TLS credentials, and other
+    protocols need packages the harness does not install.)"""
+    import socket
+    from urllib.parse import urlsplit
+
+    try:
+        url = urlsplit(scheduler if "://" in scheduler else f"tcp://{scheduler}")
+        host, port = (url.hostname, url.port) if url.scheme == "tcp" else (None, None)
+    except ValueError:  # e.g. an unclosed IPv6 bracket, a port beyond 65535
+        host, port = None, None
+    if not host or port is None:
+        raise ExecutorError(f"--scheduler {scheduler!r} is not an address like tcp://HOST:PORT")
+    try:
+        socket.create_connection((host, port), timeout=timeout_s).close()
+    except OSError as exc:
+        raise ExecutorError(
+            f"cannot connect to the Dask scheduler at {scheduler}: {exc.strerror or exc}"
+        ) from None
+
+
 def run_dask(
     chunks: list[Chunk], scheduler: str, fn=run_chunk
 ) -> Iterator[tuple[Chunk, list[dict]]]:

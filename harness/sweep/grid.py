@@ -17,6 +17,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 MANIFEST_VERSION = 1
+# Most runs one sweep may hold.  Every task key is listed in memory (about 100 bytes each
+# in Python) and every stored row is read back for the summary; at the linear model's
+# 1-100 ms per run, 1e6 runs are up to a day of CPU.  Checked before anything is written.
+MAX_RUNS = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -69,6 +73,34 @@ class SweepConfig:
     @property
     def n_tasks(self) -> int:
         return self.gyration[2] * self.restitution[2] * self.samples
+
+
+def config_problem(config: SweepConfig) -> str:
+    """Why the sweep cannot run ('' when it can): grid values outside what a scene
+    accepts (reference.scene: ρ in GYRATION_RANGE, so ρ = 0 is refused as by simulate and
+    analyze; γ in [0, 1]), too many runs, no samples."""
+    from reference.scene import GYRATION_RANGE, MAX_VERTICES
+
+    lo, hi = GYRATION_RANGE
+    a, b, _ = config.gyration
+    if not (lo <= min(a, b) and max(a, b) <= hi):
+        return (
+            f"--gyration values must be in [{lo:g}, {hi:g}] (rho = 0 has no rotational "
+            f"inertia; simulate and analyze refuse it too), got {a:g}:{b:g}"
+        )
+    a, b, _ = config.restitution
+    if not (0.0 <= min(a, b) and max(a, b) <= 1.0):
+        return f"--restitution values must be in [0, 1], got {a:g}:{b:g}"
+    if not 2 <= config.n <= MAX_VERTICES:
+        return f"--n must be in [2, {MAX_VERTICES}], got {config.n}"
+    if config.samples < 1:
+        return f"--samples must be >= 1, got {config.samples}"
+    if config.n_tasks > MAX_RUNS:
+        return (
+            f"the sweep has {config.n_tasks:.3g} runs ({config.restitution[2]} gamma x "
+            f"{config.gyration[2]} rho x {config.samples} samples); at most {MAX_RUNS:g}"
+        )
+    return ""
 
 
 def default_min_decades(engine: str) -> float:

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..outputs import atomic_write
 from .grid import SweepConfig
 from .stats import (
     as_grid,
@@ -172,6 +173,16 @@ def exponent_map_figure(
     return fig
 
 
+def _save(fig, path, dpi: int) -> None:
+    """Write the figure atomically (a sweep's PNGs are redrawn on every run, so an old
+    one is replaced) and free it."""
+    try:
+        with atomic_write(path, force=True) as tmp:
+            fig.savefig(tmp, dpi=dpi)
+    finally:
+        _plt().close(fig)
+
+
 def make_sweep_figures(
     sweep_dir: Path, df: pd.DataFrame, config: SweepConfig, boundary_points: int = 61
 ) -> dict:
@@ -185,8 +196,7 @@ def make_sweep_figures(
 
     fig = exponent_map_figure(stats, config, bounds, label)
     paths["exponent_map"] = str(sweep_dir / "exponent-map.png")
-    fig.savefig(paths["exponent_map"], dpi=130)
-    plt.close(fig)
+    _save(fig, paths["exponent_map"], dpi=130)
 
     fig, ax = plt.subplots(figsize=(8, 6.5), layout="constrained")
     mesh = _heatmap(ax, stats, config, "frac_simultaneous", "viridis", None, lambda x: f"{x:.2f}")
@@ -196,15 +206,13 @@ def make_sweep_figures(
     ax.set_title(f"fraction of runs ending in a simultaneous impact ({label})", fontsize=9)
     fig.colorbar(mesh, ax=ax, label="fraction")
     paths["simultaneous"] = str(sweep_dir / "simultaneous.png")
-    fig.savefig(paths["simultaneous"], dpi=130)
-    plt.close(fig)
+    _save(fig, paths["simultaneous"], dpi=130)
 
     fig, axes = plt.subplots(2, 2, figsize=(10, 7.5), layout="constrained")
     plot_sections(list(axes.ravel()), {config.engine: df}, {config.engine: config}, config.n)
     fig.suptitle(f"sections of the exponent map: runs (dots), means, c_lin ({label})", fontsize=9)
     paths["sections"] = str(sweep_dir / "sections.png")
-    fig.savefig(paths["sections"], dpi=130)
-    plt.close(fig)
+    _save(fig, paths["sections"], dpi=130)
     return paths
 
 
@@ -241,6 +249,5 @@ def make_compare_figure(
     )
     path = Path(root) / f"compare-{other[0]}-vs-{base[0]}.png"
     fig.suptitle(f"energy exponent: {other[0]} against {base[0]} (n = {base[2].n})")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, path, dpi=110)
     return str(path)

@@ -33,8 +33,14 @@ def vertex_frame(y, px, py):
     """Frame of the body point (px, py, 0) over flat ground: gap z + r_z, normal e_z,
     lever r, roundoff GAP_NOISE_ULPS ε (|z| + |r_z|)."""
     rx, ry, rz = vertex_lever(y, px, py)
-    noise = GAP_NOISE_ULPS * EPS * (abs(y[2]) + abs(rz))
-    return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, noise)
+    return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[2], rz))
+
+
+@njit(cache=True)
+def vertex_gap_noise(z, rz):
+    """Roundoff of a vertex gap z + r_z: GAP_NOISE_ULPS ε (|z| + |r_z|) (|r_z| ≤ a bounds
+    it for every vertex)."""
+    return GAP_NOISE_ULPS * EPS * (abs(z) + abs(rz))
 
 
 @njit(cache=True)
@@ -108,6 +114,18 @@ def point_jet(y, px, py, acc):
     ground."""
     f = vertex_frame(y, px, py)
     return Jet(f.gap, normal_velocity(y, f, True), vertex_normal_acceleration(y, f, acc), f.noise)
+
+
+@njit(cache=True)
+def rim_jet(y, acc, radius):
+    """Height, rate and acceleration of the body points (a, 0) and (0, a) less the
+    centre's: (px, py, qx, qy, rx, ry).  A vertex at body direction c = (cos θ, sin θ)
+    has gap z + c·p, rate v_z + c·q and acceleration v̇_z + c·r (all linear in c), so
+    |g″| ≤ |v̇_z| + |r| for every point of the rim."""
+    jx = point_jet(y, radius, 0.0, acc)
+    jy = point_jet(y, 0.0, radius, acc)
+    z, vz = y[2], y[9]
+    return jx.gap - z, jy.gap - z, jx.rate - vz, jy.rate - vz, jx.accel - acc[2], jy.accel - acc[2]
 
 
 @njit(cache=True)

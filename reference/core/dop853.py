@@ -4,9 +4,11 @@ scipy's coefficients, initial step, error norm and step control (scipy.integrate
 
 Grid samples inside a chunk are taken by one DOP853 step from the start of the accepted
 step that contains them (a shorter step: no less accurate).  With `watch_forces` the
-held forces λ (known at every step end: the FSAL derivative computes them) are watched:
-when one turns negative inside a step, its zero is located there, on one-step
-evaluations, to LOCATE_XTOL of the chunk (`locate_lift_off`): the lift-off."""
+held forces λ (known at every step end: the FSAL derivative computes them) are watched,
+and the gaps of the contacts in `watch`: when one turns negative inside a step, its zero
+is located there on the step's dense output (scipy's 7th-order interpolant, three more
+stages), to LOCATE_XTOL of the chunk (`locate_in_step`): a lift-off or a crossing, as
+solve_ivp locates its events."""
 
 import math
 from collections import namedtuple
@@ -16,7 +18,8 @@ from numba import njit
 
 from . import dop853_tableau as tab
 from .clock import two_sum_add
-from .held import held_rhs
+from .contacts import contact_frame
+from .held import held_forces, held_rhs
 from .output import push_sample
 from .tolerances import EPS, LOCATE_ITERATIONS, LOCATE_XTOL
 
@@ -26,12 +29,16 @@ DOP_B = np.ascontiguousarray(tab.B)
 DOP_C = np.ascontiguousarray(tab.C)
 DOP_E3 = np.ascontiguousarray(tab.E3)
 DOP_E5 = np.ascontiguousarray(tab.E5)
+DOP_A_EXTRA = np.ascontiguousarray(tab.A_EXTRA)
+DOP_D = np.ascontiguousarray(tab.D)
+N_STAGES_EXTRA = tab.N_STAGES_EXTENDED - tab.N_STAGES - 1
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0  # scipy's step control
 ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 
-INT_DONE, INT_LIFT_OFF, INT_FAILED = 0, 1, 2
-# status; s: where the integration stopped (the chunk's end, or the lift-off); nfev;
-# leaving: index (into the held list) of the contact whose force reached zero
+INT_DONE, INT_LIFT_OFF, INT_FAILED, INT_CROSSING = 0, 1, 2, 3
+# status; s: where the integration stopped (the chunk's end, the lift-off or the
+# crossing); nfev; leaving: index (into the held list) of the contact whose force reached
+# zero
 Integration = namedtuple("Integration", ["status", "s", "nfev", "leaving"])
 
 # `st` in this module is a records.SCRATCH record: stages K (13 rows: 12 stages and
@@ -112,33 +119,86 @@ def initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st):
 
 
 @njit(cache=True)
-def _force_at(y, f, sigma, model, pts, idx, m, work, st, i):
-    """Held force i after one DOP853 step of size σ from (y, f) (state into st.ys)."""
-    dop853_step(y, f, sigma, model, pts, idx, m, work, st.Ks, st.ys, st.tmp)
-    return work.lam[i]
+def dense_output(y, y_new, h, model, pts, idx, m, work, st):
+    """scipy's DOP853 dense output of the step y → y_new of size h (stages in st.K, f(y)
+    its first row and f(y_new) its last): three more stages into st.K[13:16] and the
+    interpolant's coefficients into st.F (rk.DOP853._dense_output_impl).  The held
+    forces in work.lam are those at y_new again on return.  Returns the number of
+    right-hand-side evaluations."""
+    K, F = st.K, st.F
+    for s in range(N_STAGES_EXTRA):
+        row = N_STAGES + 1 + s
+        for c in range(13):
+            acc = 0.0
+            for j in range(row):
+                acc += DOP_A_EXTRA[s, j] * K[j, c]
+            st.tmp[c] = y[c] + h * acc
+        held_rhs(st.tmp, model, pts, idx, m, work, K[row])
+    for c in range(13):
+        dy = y_new[c] - y[c]
+        F[0, c] = dy
+        F[1, c] = h * K[0, c] - dy
+        F[2, c] = 2.0 * dy - h * (K[N_STAGES, c] + K[0, c])
+        for p in range(DOP_D.shape[0]):
+            acc = 0.0
+            for j in range(N_STAGES + 1 + N_STAGES_EXTRA):
+                acc += DOP_D[p, j] * K[j, c]
+            F[3 + p, c] = h * acc
+    for i in range(m):
+        work.lam[i] = st.lam_new[i]
+    return N_STAGES_EXTRA
 
 
 @njit(cache=True)
-def locate_lift_off(y, f, h, model, pts, idx, m, work, st, i, lam0, xtol):
-    """σ in (0, h] where held force i (lam0 ≥ 0 at σ = 0, negative at h) reaches zero:
-    Illinois regula falsi with bisection steps, to xtol + 4ε σ.  Returns (σ, nfev);
-    st.ys holds the state there."""
-    lo, flo = 0.0, lam0
-    hi = h
-    fhi = _force_at(y, f, h, model, pts, idx, m, work, st, i)
-    nfev = N_STAGES
+def dense_state(y, F, x, out):
+    """The interpolated state at the fraction x ∈ [0, 1] of the step from y
+    (Dop853DenseOutput._call_impl)."""
+    n_pow = F.shape[0]
+    for c in range(13):
+        v = 0.0
+        for i in range(n_pow):
+            v += F[n_pow - 1 - i, c]
+            v *= x if i % 2 == 0 else 1.0 - x
+        out[c] = v + y[c]
+
+
+@njit(cache=True)
+def _lowest_gap(y, model, pts, watch, n_watch):
+    """The smallest gap among contacts watch[:n_watch] at y."""
+    g = math.inf
+    for i in range(n_watch):
+        g = min(g, contact_frame(y, model.flat_ground, pts, watch[i]).gap)
+    return g
+
+
+@njit(cache=True)
+def _watched_at(y, sigma, h, model, pts, idx, m, work, st, leaving, watch, n_watch):
+    """At local time σ of the step (its dense output, state into st.ys): held force
+    `leaving` if ≥ 0, else the lowest gap of watch[:n_watch]."""
+    dense_state(y, st.F, sigma / h, st.ys)
+    if leaving >= 0:
+        held_forces(st.ys, model, pts, idx, m, work)
+        return work.lam[leaving]
+    return _lowest_gap(st.ys, model, pts, watch, n_watch)
+
+
+@njit(cache=True)
+def locate_in_step(y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n_watch, xtol):
+    """σ in (0, h] where the watched value (held force `leaving`, or the lowest watched
+    gap: v0 > 0 at the step's start, vh ≤ 0 at its end) reaches zero, on the step's
+    dense output: Illinois regula falsi with bisection steps, to xtol + 4ε σ.  Returns
+    (σ, right-hand-side-like evaluations: the held forces'); st.ys holds the state
+    there."""
+    lo, flo, hi, fhi = 0.0, v0, h, vh
     side = 0
+    it = 0
     for it in range(LOCATE_ITERATIONS):
         if hi - lo <= xtol + 4.0 * EPS * hi:
             break
-        if it % 3 == 2 or flo == fhi:
+        x = 0.5 * (lo + hi) if it % 3 == 2 or flo == fhi else hi - fhi * (hi - lo) / (fhi - flo)
+        if not lo < x < hi:
             x = 0.5 * (lo + hi)
-        else:
-            x = hi - fhi * (hi - lo) / (fhi - flo)
-            if not lo < x < hi:
-                x = 0.5 * (lo + hi)
-        fx = _force_at(y, f, x, model, pts, idx, m, work, st, i)
-        nfev += N_STAGES
+        fx = _watched_at(y, x, h, model, pts, idx, m, work, st, leaving, watch, n_watch)
         if fx > 0.0:
             lo, flo = x, fx
             if side == -1:
@@ -149,8 +209,8 @@ def locate_lift_off(y, f, h, model, pts, idx, m, work, st, i, lam0, xtol):
             if side == 1:
                 flo *= 0.5
             side = 1
-    _force_at(y, f, hi, model, pts, idx, m, work, st, i)
-    return hi, nfev + N_STAGES
+    _watched_at(y, hi, h, model, pts, idx, m, work, st, leaving, watch, n_watch)
+    return hi, it + 2 if leaving >= 0 else 0
 
 
 @njit(cache=True)
@@ -201,11 +261,14 @@ def integrate_held(
     clock,
     max_samples,
     watch_forces,
+    watch,
+    n_watch,
 ):
     """Integrate the held motion from y (in place) over [0, s_end] with scipy's adaptive
     DOP853; grid samples at the local times grid[:n_grid] (ascending, inside (0, s_end)),
     stamped with clock = (t_hi, t_lo) + the local time.  With watch_forces, stop where a
-    held force reaches zero (INT_LIFT_OFF, y = the state there)."""
+    held force reaches zero (INT_LIFT_OFF, y = the state there); with n_watch > 0, where
+    the lowest gap of contacts watch[:n_watch] reaches zero (INT_CROSSING)."""
     f = st.f
     held_rhs(y, model, pts, idx, m, work, f)
     nfev = 1
@@ -244,20 +307,27 @@ def integrate_held(
             rejected = True
         for i in range(m):
             st.lam_new[i] = work.lam[i]
-        if watch_forces:
-            i = _most_negative(st.lam_new, m)
-            if i >= 0:
-                xtol = LOCATE_XTOL * s_end
-                sigma, nf = locate_lift_off(
-                    y, f, h, model, pts, idx, m, work, st, i, st.lam_cur[i], xtol
-                )
-                y_new[:] = st.ys
-                gi, nf2 = _grid_samples(
-                    y, f, t, t + sigma, grid, gi, n_grid, model, pts, idx, m, work, st, out,
-                    clock, max_samples,
-                )  # fmt: skip
-                y[:] = y_new
-                return Integration(INT_LIFT_OFF, t + sigma, nfev + nf + nf2, i)
+        leaving = _most_negative(st.lam_new, m) if watch_forces else -1
+        v0, vh, status = 0.0, 0.0, INT_DONE
+        if leaving >= 0:
+            v0, vh, status = st.lam_cur[leaving], st.lam_new[leaving], INT_LIFT_OFF
+        elif n_watch > 0:
+            v0 = _lowest_gap(y, model, pts, watch, n_watch)
+            vh = _lowest_gap(y_new, model, pts, watch, n_watch)
+            status = INT_CROSSING
+        if leaving >= 0 or (n_watch > 0 and vh <= 0.0):
+            nfev += dense_output(y, y_new, h, model, pts, idx, m, work, st)
+            sigma, nf = locate_in_step(
+                y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n_watch,
+                LOCATE_XTOL * s_end,
+            )  # fmt: skip
+            y_new[:] = st.ys
+            gi, nf2 = _grid_samples(
+                y, f, t, t + sigma, grid, gi, n_grid, model, pts, idx, m, work, st, out,
+                clock, max_samples,
+            )  # fmt: skip
+            y[:] = y_new
+            return Integration(status, t + sigma, nfev + nf + nf2, leaving)
         gi, nf = _grid_samples(
             y, f, t, t_new, grid, gi, n_grid, model, pts, idx, m, work, st, out, clock, max_samples
         )

@@ -18,29 +18,35 @@ from .tolerances import (
 
 
 @njit(cache=True)
-def chunk_horizon(y, model, gap, rate, accel, noise, held):
-    """Largest safe chunk from the free contacts' jets (held[k]: contact k is held).
+def horizon_bound(acc_scale, gravity):
+    """K = HORIZON_ACC_FACTOR × (a scale of |g″|) + g: the curvature the chunk horizon
+    allows a free gap (a margin on its current second derivative, not a bound)."""
+    return HORIZON_ACC_FACTOR * acc_scale + gravity + TINY
 
-    Quadratic lower bound with K = HORIZON_ACC_FACTOR max|g″| + g over the free
-    contacts (a margin on their current second derivatives), and at most
-    LOCAL_TIME_FRACTION of min(√(L/K), ROTATION_TIME_FACTOR a/V)."""
-    acc_scale = 0.0
-    for k in range(gap.shape[0]):
-        if not held[k]:
-            acc_scale = max(acc_scale, abs(accel[k]))
-    K = HORIZON_ACC_FACTOR * acc_scale + model.gravity + TINY
-    h = math.inf
-    for k in range(gap.shape[0]):
-        if held[k]:
-            continue
-        d = safe_step(max(gap[k], noise[k]), rate[k], accel[k], K, 0.0, h)
-        if d < h:
-            h = d
+
+@njit(cache=True)
+def local_time_cap(y, model, K):
+    """LOCAL_TIME_FRACTION of min(√(L/K), ROTATION_TIME_FACTOR a/V): a chunk stays short
+    against the time the body takes to fall its own size and the rim its radius."""
     t_local = math.sqrt(max(length_scale(y, model.radius), TINY) / K)
     vs = velocity_scale(y, model.radius)
     if vs > 0:
         t_local = min(t_local, ROTATION_TIME_FACTOR * model.radius / vs)
-    return min(h, LOCAL_TIME_FRACTION * t_local)
+    return LOCAL_TIME_FRACTION * t_local
+
+
+@njit(cache=True)
+def safe_horizon(cs, i0, i1, K, h):
+    """h shortened to the first root of max(P2, T2) of each examined free gap
+    cs.cand[i0:i1] (jets in cs): P2 its quadratic lower bound with curvature K, T2 its
+    Taylor quadratic (not a bound: long chunks where the gaps curve away; a crossing it
+    lets through is found after the chunk and located inside it,
+    `phases.contact_step`)."""
+    for i in range(i0, i1):
+        d = safe_step(max(cs.gap[i], cs.noise[i]), cs.rate[i], cs.accel[i], K, 0.0, h)
+        if d < h:
+            h = d
+    return h
 
 
 @njit(cache=True)

@@ -8,13 +8,19 @@ import math
 import numpy as np
 from numba import njit
 
+from .candidates import (
+    certified_horizon,
+    is_held,
+    set_aside_approaching,
+    touching_candidates,
+)
 from .clock import time_until, two_sum_add
-from .contacts import contact_frame, contact_jet, length_scale, rate_noise, velocity_scale
-from .dop853 import INT_FAILED, INT_LIFT_OFF, integrate_held
+from .contacts import contact_frame, length_scale, rate_noise, velocity_scale
+from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, integrate_held
 from .events import activate, end_run, hold, resolve_impact
 from .flight import flight_bounds, flight_constants, free_flight
 from .held import held_acceleration, held_forces, project_held
-from .horizon import chunk_horizon, force_trend_limit
+from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
 from .output import push_phase, push_sample
 from .records import (
@@ -31,11 +37,11 @@ from .records import (
 from .search import find_flight_event
 from .tolerances import (
     CONTACT_GAP_RES,
-    LOCATE_ITERATIONS,
-    LOCATE_XTOL,
     MAX_SEARCH_ITERATIONS,
     TINY,
+    WINDOW_MAX,
 )
+from .window import use_window, vertex_window
 
 DONE, NEEDS_ROWS = 0, 1
 
@@ -157,33 +163,22 @@ def close_contact_phase(state, model, stats, out):
 
 
 @njit(cache=True)
-def _contact_jets(state, model, pts, ws, cs):
-    """Jets of every contact with the held acceleration (forces into ws.lam)."""
-    acc = held_acceleration(state.y, model, pts, state.active, state.n_active, ws)
-    for k in range(pts.shape[0]):
-        j = contact_jet(state.y, model.flat_ground, pts, k, acc)
-        cs.gap[k], cs.rate[k], cs.accel[k], cs.noise[k] = j.gap, j.rate, j.accel, j.noise
-        cs.held[k] = False
-    for i in range(state.n_active):
-        cs.held[state.active[i]] = True
-
-
-@njit(cache=True)
-def _touching_event(state, model, pts, opts, stats, out, ws, cs, gap_res):
-    """A free contact touching (gap within max(noise, gap_res)) while approaching (an
-    impact with the held ones) or at rest accelerating into the ground (activation)
-    ends the phase.  Returns True if so."""
+def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res):
+    """A free contact touching while approaching (gap within its roundoff: an impact with
+    the held ones) or at rest accelerating into the ground (gap within max(noise,
+    gap_res): an activation) ends the phase.  Returns True if so."""
     vnoise = rate_noise(state.y, model.radius)
     n_hit = n_land = 0
     hitting = cs.hitting
-    for k in range(pts.shape[0]):
-        if cs.held[k] or cs.gap[k] > max(cs.noise[k], gap_res):
+    for i in range(n_cand):
+        if cs.gap[i] > max(cs.noise[i], gap_res):
             continue
-        if cs.rate[k] < -vnoise:
-            hitting[n_hit] = k
-            n_hit += 1
-        elif cs.rate[k] <= vnoise and cs.accel[k] < 0:
-            cs.together[n_land] = k
+        if cs.rate[i] < -vnoise:
+            if cs.gap[i] <= cs.noise[i]:
+                hitting[n_hit] = cs.cand[i]
+                n_hit += 1
+        elif cs.rate[i] <= vnoise and cs.accel[i] < 0:
+            cs.together[n_land] = cs.cand[i]
             n_land += 1
     if n_hit:
         close_contact_phase(state, model, stats, out)
@@ -215,56 +210,43 @@ def _set_tolerances(y, model, rtol, atol):
 
 
 @njit(cache=True)
-def _crossed(y, model, pts, cs, gap_res):
+def _crossed(y, state, model, pts, opts, cs, gap_res):
     """Free contacts below the ground beyond their resolution at y: how many (listed in
-    cs.together)."""
-    n = 0
-    for k in range(pts.shape[0]):
-        if cs.held[k]:
+    cs.together).  For large polygons only the window of vertices below the ground at y
+    is looked at (`vertex_window` with K = δ = 0 is exact: the others are above)."""
+    n = pts.shape[0]
+    first, count = 0, n
+    if use_window(model, opts.window_search, n):
+        k0, half = vertex_window(y, model.radius, n, 0.0, 0.0, WINDOW_MAX)
+        first, count = k0 - half, min(2 * half + 1, n)
+    m = 0
+    for i in range(count):
+        k = (first + i) % n
+        if is_held(state, k):
             continue
         f = contact_frame(y, model.flat_ground, pts, k)
         if f.gap < -max(f.noise, gap_res):
-            cs.together[n] = k
-            n += 1
-    return n
-
-
-@njit(cache=True)
-def _min_gap_after(state, model, pts, opts, ws, cs, s, n_crossed, out):
-    """Lowest gap of the crossed contacts after integrating (and projecting) the held
-    motion for s from the chunk's start (ws.y_start); the state into ws.y_chunk."""
-    ws.y_chunk[:] = ws.y_start
-    grid = np.empty(0)
-    r = integrate_held(
-        ws.y_chunk, s, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
-        ws, ws, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False,
-    )  # fmt: skip
-    project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
-    g = math.inf
-    for i in range(n_crossed):
-        g = min(g, contact_frame(ws.y_chunk, model.flat_ground, pts, cs.together[i]).gap)
-    return g, r.nfev
+            cs.together[m] = k
+            m += 1
+    return m
 
 
 @njit(cache=True)
 def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
-    """The first time in (0, h] the crossed contacts reach the ground (bisection on
-    re-integrations from the chunk's start): the horizon's backstop (it should be rare:
-    the bound makes crossings impossible up to roundoff)."""
-    lo, hi = 0.0, h
-    for _ in range(LOCATE_ITERATIONS):
-        if hi - lo <= LOCATE_XTOL * h + 4.0 * 2.220446049250313e-16 * hi:
-            break
-        mid = 0.5 * (lo + hi)
-        g, nfev = _min_gap_after(state, model, pts, opts, ws, cs, mid, n_crossed, out)
-        stats.contact_rhs_evals += nfev
-        if g > 0.0:
-            lo = mid
-        else:
-            hi = mid
-    g, nfev = _min_gap_after(state, model, pts, opts, ws, cs, hi, n_crossed, out)
-    stats.contact_rhs_evals += nfev
-    return hi
+    """The first time in (0, h] the crossed contacts (cs.together[:n_crossed]) reach the
+    ground: the chunk integrated again from its start watching their gaps, the zero
+    located inside the step that holds it (dop853.locate_crossing); ws.y_chunk ends
+    there, projected.  The horizon's backstop: its Taylor part is not a bound."""
+    ws.y_chunk[:] = ws.y_start
+    grid = np.empty(0)
+    r = integrate_held(
+        ws.y_chunk, h, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
+        ws, ws, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False, cs.together,
+        n_crossed,
+    )  # fmt: skip
+    stats.contact_rhs_evals += r.nfev
+    project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
+    return r.s
 
 
 @njit(cache=True)
@@ -272,16 +254,17 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     """One step of a contact phase: the event that ends it, or one integrated chunk."""
     y = state.y
     gap_res = state.gap_res
-    _contact_jets(state, model, pts, ws, cs)
-    if _touching_event(state, model, pts, opts, stats, out, ws, cs, gap_res):
+    acc = held_acceleration(y, model, pts, state.active, state.n_active, ws)
+    ex = touching_candidates(state, model, pts, opts, acc, cs, gap_res)
+    if _touching_event(state, model, pts, opts, stats, out, ws, cs, ex.n, gap_res):
         return DONE
+    ex, n_near, t_near = set_aside_approaching(cs, ex, rate_noise(y, model.radius), gap_res)
     m = state.n_active
     lam = ws.lam[:m].copy()
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
-    h = chunk_horizon(y, model, cs.gap, cs.rate, cs.accel, cs.noise, cs.held)
+    h, _ = certified_horizon(state, model, pts, acc, cs, ex, min(remaining, t_near))
     if state.has_trend:
         h = force_trend_limit(h, lam, state.lam_prev, state.h_prev, m)
-    h = min(h, remaining)
     if h <= 0:
         close_contact_phase(state, model, stats, out)
         if remaining > 0:
@@ -298,24 +281,25 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     ns0 = out.counts[N_SAMPLES]
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
-        ws, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True,
+        ws, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.near, n_near,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     if r.status == INT_FAILED:
         end_run(state, STATUS_FAILED_INTEGRATION, state.active, m)
         return DONE
-    project_held(ws.y_chunk, model, pts, state.active, m, ws)
+    if r.status != INT_CROSSING:  # a crossing stays where its gap is zero: the impact's state
+        project_held(ws.y_chunk, model, pts, state.active, m, ws)
     if r.status == INT_LIFT_OFF:
         return _lift_off(state, model, pts, opts, stats, out, ws, r)
-    n_crossed = _crossed(ws.y_chunk, model, pts, cs, gap_res)
+    n_crossed = _crossed(ws.y_chunk, state, model, pts, opts, cs, gap_res)
     if n_crossed:
         stats.horizon_backstops += 1
-        s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed)
+        s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, r.s, n_crossed)
         _drop_samples_after(out, ns0, state, s_star)
-        state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_star)
-        y[:] = ws.y_chunk
-        state.has_trend = False
-        return DONE
+        return _cut_chunk(state, ws, s_star)
+    if r.status == INT_CROSSING:  # an approaching contact reached the ground: its impact next
+        stats.contact_chunks += 1
+        return _cut_chunk(state, ws, r.s)
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
     y[:] = ws.y_chunk
@@ -327,6 +311,16 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     if remaining - h <= 0:
         push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
         close_contact_phase(state, model, stats, out)
+    return DONE
+
+
+@njit(cache=True)
+def _cut_chunk(state, ws, s):
+    """Advance to local time s of the chunk (state ws.y_chunk), where a free contact
+    reached the ground."""
+    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s)
+    state.y[:] = ws.y_chunk
+    state.has_trend = False
     return DONE
 
 

@@ -134,7 +134,8 @@ SCRATCH = np.dtype(
         ("lam", np.float64, (3,)),  # forces or impulses
         ("resp", np.float64, (3, 7)),  # M⁻¹J_iᵀ and w_i per contact
         ("geo", np.float64, (3, 6)),  # normal and lever per contact
-        ("K", np.float64, (13, 13)),  # DOP853 stages and f(y_new)
+        ("K", np.float64, (16, 13)),  # DOP853 stages, f(y_new), dense-output stages
+        ("F", np.float64, (7, 13)),  # dense-output coefficients of a step
         ("Ks", np.float64, (13, 13)),  # stages of one-step evaluations
         ("f", np.float64, (13,)),
         ("y_new", np.float64, (13,)),

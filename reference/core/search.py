@@ -19,11 +19,10 @@ import math
 
 from numba import njit
 
-from .contacts import contact_jet, point_jet
+from .contacts import contact_jet, rim_jet
 from .flight import flight_acceleration, free_flight
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
 from .roots import safe_step, zero_bracket_end
-from .rotation import rotation_columns_xy
 from .tolerances import (
     BRACKET_ITERATIONS,
     EPS,
@@ -33,10 +32,10 @@ from .tolerances import (
     POLISH_REL_TOL,
     RATE_NOISE_ULPS,
     SIMULTANEOUS_FACTOR,
-    SMALL_N,
     TINY,
     WINDOW_MAX,
 )
+from .window import use_window, vertex_window, window_offsets
 
 # res[...] of `examine`: the smallest safe step and the contact that sets it, the
 # earliest hit's time and contact, a contact landing at rest
@@ -65,34 +64,6 @@ def examine(y, acc, flat, pts, k, K, B, vnoise, res):
     if d < res[STEP]:
         res[STEP] = d
         res[STEP_K] = k
-
-
-@njit(cache=True)
-def vertex_window(y, radius, n, K, delta, margin):
-    """The vertices that can reach the ground within δ (the others are safe by P2): the
-    index range k0 − half … k0 + half (mod n) around the lowest direction; O(1).
-
-    P2 of vertex k at δ is Z(δ) + a c_k·u(δ) with c_k = (cos θ_k, sin θ_k),
-    Z = z + v_z δ − Kδ²/2 and u = (R20, R21) + δ (ω × R)'s z row: a vertex's height and
-    rate are linear in its body position.  P2 is concave in δ, so vertex k is safe over
-    [0, δ] when a|u| cos(θ_k − ∠u) > −Z: outside an arc of half-width π − acos(−Z/(a|u|))
-    around ∠u + π.  half = n // 2 means every vertex."""
-    R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y)
-    A = y[10] * R10 - y[11] * R00
-    Bq = y[10] * R11 - y[11] * R01
-    ux, uy = R20 + A * delta, R21 + Bq * delta
-    U = math.sqrt(ux * ux + uy * uy)
-    Z = y[2] + y[9] * delta - 0.5 * K * delta * delta
-    dth = 2.0 * math.pi / n
-    centre = math.atan2(uy, ux) + math.pi
-    if radius * U <= 0.0 or -Z / (radius * U) <= -1.0:
-        half = 0
-    else:
-        c = -Z / (radius * U)
-        W = math.pi if c >= 1.0 else math.pi - math.acos(c)
-        half = int(math.ceil(W / dth))
-    half = min(half + margin, n // 2)
-    return int(math.floor(centre / dth + 0.5)), half
 
 
 @njit(cache=True)
@@ -125,11 +96,8 @@ def circle_step(y, acc, g, radius, B):
     root is bracketed from below by chords and from above by Newton steps.  Returns (the
     root within 1e-3 from below, F(0) = z − |p|, |p| = a sin α)."""
     z, vz = y[2], y[9]
-    jx = point_jet(y, radius, 0.0, acc)
-    jy = point_jet(y, 0.0, radius, acc)
-    px, py = jx.gap - z, jy.gap - z
-    qx, qy = jx.rate - vz, jy.rate - vz
-    rn = math.sqrt((jx.accel - acc[2]) ** 2 + (jy.accel - acc[2]) ** 2)
+    px, py, qx, qy, rx, ry = rim_jet(y, acc, radius)
+    rn = math.sqrt(rx * rx + ry * ry)
     pn = math.sqrt(px * px + py * py)
     f0 = z - pn
     if f0 <= 0.0:
@@ -177,12 +145,8 @@ def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res
         return math.inf
     dlt = min(res[STEP], left, 4.0 * last_dlt)
     while True:
-        k1, h1 = vertex_window(y, radius, n, K, dlt, 3)
-        d = (k1 - k0) % n
-        if d > n // 2:
-            d -= n
-        lo1, hi1 = d - h1, d + h1
-        if 2 * h1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= WINDOW_MAX:
+        lo1, hi1 = window_offsets(y, radius, n, K, dlt, 3, k0)
+        if hi1 - lo1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= WINDOW_MAX:
             break
         dlt *= 0.25
     for off in range(h + 1, hi1 + 1):
@@ -369,7 +333,7 @@ def find_flight_event(
     together[:n_together] (res: 5 floats of scratch)."""
     n = pts.shape[0]
     g = model.gravity
-    windowed = model.flat_ground and window_search and n > SMALL_N
+    windowed = use_window(model, window_search, n)
     y[:] = y0
     s = 0.0
     vnoise = (

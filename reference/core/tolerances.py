@@ -46,6 +46,11 @@ MAX_SEARCH_ITERATIONS = 100_000
 # lowest direction and WINDOW_MAX more on each side (reference.core.search).
 SMALL_N = 32
 WINDOW_MAX = 3
+# A contact step adds at most WINDOW_GROW vertices at a time to those it examines, else
+# shortens its chunk (×¼); after WINDOW_ROUNDS rounds it examines every vertex
+# (reference.core.candidates).
+WINDOW_GROW = 16
+WINDOW_ROUNDS = 64
 
 # Chatter: a bounce lower than CHATTER_BOUNCE_FLOOR² roundoff bands of its gap (speed
 # below CHATTER_BOUNCE_FLOOR √(2 |a_n| noise)) cannot be resolved one impact at a time;

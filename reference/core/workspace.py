@@ -10,13 +10,14 @@ from numba import njit
 ContactLists = namedtuple(
     "ContactLists",
     [
-        "gap",  # (n,) jets of every contact
+        "cand",  # (n,) the free contacts a contact step examines
+        "gap",  # (n,) their jets, in the order of cand
         "rate",
         "accel",
         "noise",
-        "held",  # (n,) bool: held contacts
         "together",  # (n,) contacts reached together, landing, pushed, crossed
         "hitting",  # (n,) contacts hitting
+        "near",  # (n,) contacts approaching within the gap resolution, watched
     ],
 )
 
@@ -24,11 +25,12 @@ ContactLists = namedtuple(
 @njit(cache=True)
 def new_contact_lists(n):
     return ContactLists(
+        np.empty(n, dtype=np.int64),
         np.empty(n),
         np.empty(n),
         np.empty(n),
         np.empty(n),
-        np.zeros(n, dtype=np.bool_),
+        np.empty(n, dtype=np.int64),
         np.empty(n, dtype=np.int64),
         np.empty(n, dtype=np.int64),
     )

@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ._text import table
+from ._text import CHATTER_LEGEND, table
 from .model import LinearModel
 
 
@@ -217,6 +217,8 @@ def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
 
 
 def format_chatter(doc: dict) -> str:
+    """The eigenvalues, CC/PCC, the rod's thresholds and the self-similar pairs, then
+    CHATTER_LEGEND."""
     lines = [
         f"chatter (no gravity): n = {doc['n']}, rho = {doc['gyration']}, "
         f"gamma = {doc['restitution']}",
@@ -251,4 +253,5 @@ def format_chatter(doc: dict) -> str:
             if cl is not None
             else "c_lin = -"
         )
+    lines += ["", CHATTER_LEGEND]
     return "\n".join(lines)

@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import Polynomial as P
 
-from ._text import table
+from ._text import SELFSIMILAR_LEGEND, table
 from .kernel import first_hit
 from .model import LinearModel
 
@@ -379,6 +379,7 @@ def analyze_selfsimilar(n: int, rho: float, gamma: float, gravity: float = 1.0) 
 
 
 def format_selfsimilar(doc: dict) -> str:
+    """The solutions as a table, then SELFSIMILAR_LEGEND."""
     rows = []
     for s in doc["solutions"]:
         rows.append(
@@ -402,4 +403,6 @@ def format_selfsimilar(doc: dict) -> str:
         + table(
             rows, ["beta", "kind", "feasible", "stable", "spectral radius", "tau0", "failed checks"]
         )
+        + "\n\n"
+        + SELFSIMILAR_LEGEND
     )

@@ -1,0 +1,61 @@
+"""Vertex windows of large polygons over flat ground.
+
+A vertex's gap, rate and acceleration are linear in its body direction c = (cos θ,
+sin θ): g = z + a c·u with u = (R20, R21).  So its quadratic lower bound over a step δ,
+P2 = g + g′δ − Kδ²/2, is a sinusoid in θ, and only an angular window around the lowest
+direction can reach the ground within δ: the flight search (reference.core.search) and
+the contact phases (reference.core.candidates) examine those vertices only, at a cost
+that does not grow with n."""
+
+import math
+
+from numba import njit
+
+from .rotation import rotation_columns_xy
+from .tolerances import SMALL_N
+
+
+@njit(cache=True)
+def use_window(model, window_search, n):
+    """Whether only the vertices near the lowest direction are examined: large polygons
+    (n > SMALL_N) over flat ground, unless the window search is turned off."""
+    return model.flat_ground and window_search and n > SMALL_N
+
+
+@njit(cache=True)
+def vertex_window(y, radius, n, K, delta, margin, lift=0.0):
+    """The vertices whose P2 can come within `lift` of the ground within δ (the others
+    are safe by P2): the index range k0 − half … k0 + half (mod n) around the lowest
+    direction, `margin` more on each side; O(1).
+
+    P2 of vertex k at δ is Z(δ) + a c_k·u(δ) with c_k = (cos θ_k, sin θ_k),
+    Z = z + v_z δ − Kδ²/2 and u = (R20, R21) + δ (ω × R)'s z row: a vertex's height and
+    rate are linear in its body position.  P2 is concave in δ, so vertex k stays above
+    `lift` over [0, δ] when a|u| cos(θ_k − ∠u) > lift − Z: outside an arc of half-width
+    π − acos((lift − Z)/(a|u|)) around ∠u + π.  half = n // 2 means every vertex."""
+    R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y)
+    A = y[10] * R10 - y[11] * R00
+    Bq = y[10] * R11 - y[11] * R01
+    ux, uy = R20 + A * delta, R21 + Bq * delta
+    U = math.sqrt(ux * ux + uy * uy)
+    Z = y[2] + y[9] * delta - 0.5 * K * delta * delta - lift
+    dth = 2.0 * math.pi / n
+    centre = math.atan2(uy, ux) + math.pi
+    if radius * U <= 0.0 or -Z / (radius * U) <= -1.0:
+        half = 0
+    else:
+        c = -Z / (radius * U)
+        W = math.pi if c >= 1.0 else math.pi - math.acos(c)
+        half = int(math.ceil(W / dth))
+    half = min(half + margin, n // 2)
+    return int(math.floor(centre / dth + 0.5)), half
+
+
+@njit(cache=True)
+def window_offsets(y, radius, n, K, delta, margin, k0):
+    """vertex_window(δ) as offsets (lo, hi) from vertex k0 (in (−n/2, n/2])."""
+    k1, h1 = vertex_window(y, radius, n, K, delta, margin)
+    d = (k1 - k0) % n
+    if d > n // 2:
+        d -= n
+    return d - h1, d + h1
