@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 from reference.linear._text import table  # noqa: F401  (the one table formatter)
 from reference.trajectory import Trajectory
 
@@ -27,3 +30,17 @@ def format_simulate(traj: Trajectory) -> str:
         for ev in traj.impacts[:8]:
             lines.append(f"  {ev.t:.15f}  {ev.contact:4d}  {ev.impulse:.6e}")
     return "\n".join(lines)
+
+
+def num(x: Any, spec: str = ".3g") -> str:
+    """A table cell's text: '-' for None or a non-finite float, yes/no for a bool, ints
+    as they are, floats by `spec`, anything else by str()."""
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int):
+        return str(x)
+    if isinstance(x, float):
+        return format(x, spec) if math.isfinite(x) else "-"
+    return str(x)

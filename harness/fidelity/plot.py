@@ -53,8 +53,8 @@ def alpha_star_figure(doc: dict[str, Any]):
     ax.set_title(
         f"fidelity limit on '{doc['scene']}': ≥ {crit['match_fraction']:.0%} of "
         f"{crit['leading']} leading impacts matched\n(bar: down to the first failing α; "
-        "dotted to a dash: passes again down to there; ▽ passes at every α, △ fails at "
-        "every α;\nhorizontal dotted lines: the α range tried)",
+        "dotted to a dash: passes again down to there;\n▽ passes at every α, △ fails at "
+        "every α; horizontal dotted lines: the α range tried)",
         fontsize=9,
     )
     ax.grid(True, which="major", alpha=0.3)

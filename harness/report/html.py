@@ -7,9 +7,10 @@ from __future__ import annotations
 import base64
 import html
 import io
-import math
 from collections.abc import Sequence
 from typing import Any
+
+from ..text import num  # noqa: F401 (the cells' text, re-exported)
 
 CSS = """
 body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif;
@@ -25,6 +26,7 @@ th { background: #f0f0f0; }
 td.l, th.l { text-align: left; }
 td.pass { background: #d9f2d9; } td.fail { background: #f7d4d4; }
 td.skip { background: #eee; color: #777; } td.na { color: #999; }
+div.wide { overflow-x: auto; }  /* a wide table scrolls, the page does not */
 figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
 figcaption { font-size: .85em; color: #555; }
 code, pre { font-family: ui-monospace, Menlo, Consolas, monospace; font-size: .85em; }
@@ -37,19 +39,6 @@ details { margin: .6em 0; } summary { cursor: pointer; font-weight: 600; }
 
 def esc(x: Any) -> str:
     return html.escape(str(x), quote=True)
-
-
-def num(x: Any, spec: str = ".3g") -> str:
-    """A cell's text: '-' for None or non-finite, ints as they are, floats by `spec`."""
-    if x is None:
-        return "-"
-    if isinstance(x, bool):
-        return "yes" if x else "no"
-    if isinstance(x, int):
-        return str(x)
-    if isinstance(x, float):
-        return format(x, spec) if math.isfinite(x) else "-"
-    return str(x)
 
 
 class Cell:
@@ -72,7 +61,7 @@ def table(
 ) -> str:
     """An HTML table; the first `left` columns are left-aligned (names), the rest right
     (numbers).  Cells are plain values (escaped text) or `Cell`s."""
-    out = ["<table>"]
+    out = ['<div class="wide"><table>']
     if caption:
         out.append(f"<caption>{esc(caption)}</caption>")
     ths = "".join(
@@ -87,7 +76,7 @@ def table(
                 cell = Cell(cell.text, f"{cell.cls} l".strip(), cell.title)
             tds.append(cell.render())
         out.append(f"<tr>{''.join(tds)}</tr>")
-    out.append("</tbody></table>")
+    out.append("</tbody></table></div>")
     return "\n".join(out)
 
 

@@ -2,20 +2,15 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
+from ..text import num as cell_text
 from ..text import table
 
 
 def num(x: Any, spec: str = ".2e") -> str:
-    if x is None:
-        return "-"
-    if isinstance(x, bool):
-        return "yes" if x else "no"
-    if isinstance(x, int):
-        return str(x)
-    return format(x, spec) if math.isfinite(x) else "-"
+    """A cell's text (harness.text.num), floats in scientific notation by default."""
+    return cell_text(x, spec)
 
 
 def format_stress(doc: dict[str, Any]) -> str:
