@@ -14,6 +14,7 @@ import math
 from numba import njit
 
 from .contacts import contact_frame, velocity_scale
+from .impact import bounce_ratio
 from .tolerances import CHATTER_BOUNCE_FLOOR, TINY
 
 
@@ -23,7 +24,7 @@ def completion_speed(y, model, pts, k, chatter_tol, vnoise):
     and at least CHATTER_BOUNCE_FLOOR √(2 |a| noise) (a bounce lower than 1e4 roundoff
     bands of its gap, |a| = g + a|ω|², cannot be resolved); for γ = 1 only the roundoff
     level vnoise (an elastic contact never accumulates impacts)."""
-    if model.gamma >= 1.0:
+    if bounce_ratio(model.gamma) >= 1.0:
         return vnoise
     small = chatter_tol * velocity_scale(y, model.radius)
     noise = contact_frame(y, model.flat_ground, pts, k).noise
@@ -34,5 +35,7 @@ def completion_speed(y, model, pts, k, chatter_tol, vnoise):
 @njit(cache=True)
 def accumulation_time(t, u, a_n, gamma):
     """When the bounces of speed u under normal acceleration a_n < 0 accumulate:
-    t + 2u / (|a_n| (1 − γ)) (a bouncing ball)."""
-    return t + 2.0 * max(u, 0.0) / (max(-a_n, TINY) * (1.0 - gamma))
+    t + 2u / (|a_n| (1 − r)) with r = bounce_ratio(γ) (a bouncing ball: the flight
+    times 2u rᵏ/|a_n| summed)."""
+    r = bounce_ratio(gamma)
+    return t + 2.0 * max(u, 0.0) / (max(-a_n, TINY) * (1.0 - r))

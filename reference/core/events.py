@@ -8,7 +8,7 @@ from numba import njit
 from .chatter import accumulation_time, completion_speed
 from .contacts import contact_frame, contact_jet, normal_velocity, rate_noise, velocity_scale
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
-from .impact import impact, pushed_contacts
+from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
 from .output import push_accumulation, push_impact, push_sample
 from .records import (
@@ -100,7 +100,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
             if vn > vnoise:
                 stats.max_completion_u_rel = max(stats.max_completion_u_rel, vn / vs)
     u = out_imp.u_post
-    if u <= vnoise and model.gamma == 0.0:
+    if u <= vnoise and bounce_ratio(model.gamma) == 0.0:  # a plastic contact stays
         ws.cand[m] = k
         m += 1
     elif u <= small:

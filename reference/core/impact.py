@@ -6,7 +6,8 @@ velocity u by ζ w (w = J M⁻¹ Jᵀ, `inertia.impulse_response`).  Newton's la
 With other contacts held, the single-impact law stands only if it leaves every held
 contact separating or resting (`pushed_contacts`); otherwise the outcome is
 undecidable in this model.  Changing the impact law is an edit of
-`post_impact_velocity` alone."""
+`post_impact_velocity` alone: the chatter series and the capture of a γ = 0 contact
+(reference.core.chatter, events) use the ratio it gives (`bounce_ratio`)."""
 
 from numba import njit
 
@@ -20,6 +21,14 @@ def post_impact_velocity(u_pre, gamma):
     """Newton's impact law (paper eq. utk3): the contact's normal velocity after the
     impact is −γ times the one before."""
     return -gamma * u_pre
+
+
+@njit(cache=True)
+def bounce_ratio(gamma):
+    """u⁺/|u⁻| of the impact law: the factor by which a contact's rebound speed shrinks
+    from one bounce to the next (γ for Newton's law).  The chatter series (a geometric
+    series of bounces) assumes it does not depend on the speed."""
+    return post_impact_velocity(-1.0, gamma)
 
 
 @njit(cache=True)
