@@ -26,6 +26,7 @@ from .core.records import (
     RETURN_DONE,
     RETURN_GROW,
 )
+from .core.tolerances import TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
 from .scene import Scene
@@ -210,6 +211,7 @@ _STATUS = {
     R.STATUS_SINGULARITY: Status.SINGULARITY,
     R.STATUS_ENERGY_EXHAUSTED: Status.SINGULARITY,
     R.STATUS_AT_REST: Status.SINGULARITY,
+    R.STATUS_TILT_FLOOR: Status.SINGULARITY,
     R.STATUS_SIMULTANEOUS: Status.SIMULTANEOUS_IMPACT,
     R.STATUS_PUSHED: Status.SIMULTANEOUS_IMPACT,
     R.STATUS_MAX_IMPACTS: Status.MAX_IMPACTS,
@@ -227,6 +229,10 @@ def status_message(state: np.void, opts: np.void) -> tuple[Status, str]:
         R.STATUS_ENERGY_EXHAUSTED: (
             f"energy exhausted to {float(opts['energy_floor']):g} of its initial excess; "
             "t_singularity extrapolated from the impact intervals"
+        ),
+        R.STATUS_TILT_FLOOR: (
+            f"inclination below {TILT_FLOOR:g} rad at t = {t:.17g}: the singularity for "
+            "double precision; t_singularity extrapolated from the impact intervals"
         ),
         R.STATUS_AT_REST: f"at rest on contacts {contacts} at t = {t:.17g}: the motion has ended",
         R.STATUS_SIMULTANEOUS: f"contacts {contacts} hit simultaneously at t = {t:.17g}",

@@ -38,7 +38,9 @@ from .records import (
     STATUS_RUNNING,
     STATUS_SINGULARITY,
     STATUS_T_END,
+    STATUS_TILT_FLOOR,
 )
+from .tolerances import TILT_FLOOR
 from .workspace import new_contact_lists
 
 # rows every step may add at most to impacts, phases and accumulation times
@@ -64,7 +66,7 @@ def extrapolate_singularity(out, t_hi):
 @njit(cache=True)
 def _motion_ended(state, model, opts, out):
     """The end checks between phases (max_impacts, all contacts down, energy exhausted,
-    t_end); sets the status and returns True when one applies."""
+    tilt below TILT_FLOOR, t_end); sets the status and returns True when one applies."""
     none = state.info  # (no contacts to name)
     if out.counts[N_IMPACTS] >= opts.max_impacts:
         end_run(state, STATUS_MAX_IMPACTS, none, 0)
@@ -80,6 +82,10 @@ def _motion_ended(state, model, opts, out):
             end_run(state, STATUS_ENERGY_EXHAUSTED, none, 0)
             state.t_singularity = extrapolate_singularity(out, state.t_hi)
             return True
+    if out.counts[N_IMPACTS] > 0 and math.hypot(y[4], y[5]) < 0.5 * TILT_FLOOR:
+        end_run(state, STATUS_TILT_FLOOR, none, 0)  # α ≈ 2 |(x, y)| of the quaternion
+        state.t_singularity = extrapolate_singularity(out, state.t_hi)
+        return True
     if time_until(state.t_hi, state.t_lo, opts.t_end) <= 0:
         end_run(state, STATUS_T_END, none, 0)
         return True

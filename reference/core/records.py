@@ -103,6 +103,7 @@ STATUS_FAILED_STUCK = 8  # the event search did not converge
 STATUS_FAILED_INTEGRATION = 9  # the contact integrator's step fell below roundoff
 STATUS_FAILED_NO_ADVANCE = 10  # a contact phase cannot advance before t_end
 STATUS_AT_REST = 11  # singularity at the start: all contacts down and at rest
+STATUS_TILT_FLOOR = 12  # singularity: tilt below TILT_FLOOR after impacts
 
 # Counters of a run (reference.stats.RunStats reads them by name).
 STATS = np.dtype(

@@ -74,3 +74,9 @@ PROJECTION_PASSES = 2
 # (and 4 ε relative), at most LOCATE_ITERATIONS function evaluations.
 LOCATE_XTOL = 1e-15
 LOCATE_ITERATIONS = 200
+
+# End of the motion: once impacts have happened, a tilt α below TILT_FLOOR (rad) is the
+# singularity for double precision: α² (heights' curvature terms, energies ∝ α²) would
+# underflow below 1e-300 and time scales ∝ √α lose their digits, so the model cannot
+# decide anything further (a sweep run reached α = 4e-296 and divided by zero).
+TILT_FLOOR = 1e-150
