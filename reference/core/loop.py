@@ -64,6 +64,18 @@ def extrapolate_singularity(out, t_hi):
 
 
 @njit(cache=True)
+def _below_tilt_floor(state, y, out):
+    """After impacts, the tilt α ≈ 2 |(x, y)| of the attitude quaternion is below
+    TILT_FLOOR: nonzero, or exactly zero with a contact held.  A body exactly flat with
+    no contact held has just landed flat: the event search reports its simultaneous
+    contacts."""
+    if out.counts[N_IMPACTS] == 0:
+        return False
+    h = math.hypot(y[4], y[5])
+    return h < 0.5 * TILT_FLOOR and (h > 0.0 or state.n_active > 0)
+
+
+@njit(cache=True)
 def _motion_ended(state, model, opts, out):
     """The end checks between phases (max_impacts, all contacts down, energy exhausted,
     tilt below TILT_FLOOR, t_end); sets the status and returns True when one applies."""
@@ -82,8 +94,8 @@ def _motion_ended(state, model, opts, out):
             end_run(state, STATUS_ENERGY_EXHAUSTED, none, 0)
             state.t_singularity = extrapolate_singularity(out, state.t_hi)
             return True
-    if out.counts[N_IMPACTS] > 0 and math.hypot(y[4], y[5]) < 0.5 * TILT_FLOOR:
-        end_run(state, STATUS_TILT_FLOOR, none, 0)  # α ≈ 2 |(x, y)| of the quaternion
+    if _below_tilt_floor(state, y, out):
+        end_run(state, STATUS_TILT_FLOOR, none, 0)
         state.t_singularity = extrapolate_singularity(out, state.t_hi)
         return True
     if time_until(state.t_hi, state.t_lo, opts.t_end) <= 0:

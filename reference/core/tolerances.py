@@ -78,5 +78,6 @@ LOCATE_ITERATIONS = 200
 # End of the motion: once impacts have happened, a tilt α below TILT_FLOOR (rad) is the
 # singularity for double precision: α² (heights' curvature terms, energies ∝ α²) would
 # underflow below 1e-300 and time scales ∝ √α lose their digits, so the model cannot
-# decide anything further (a sweep run reached α = 4e-296 and divided by zero).
+# decide anything further (a sweep run reached α = 4e-296 and divided by zero).  An
+# exactly flat body (α = 0, e.g. landing flat) is left to the event search.
 TILT_FLOOR = 1e-150
