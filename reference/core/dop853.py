@@ -244,6 +244,37 @@ def _most_negative(lam, m):
 
 
 @njit(cache=True)
+def _accepted_step(y, f, t, s_end, h_abs, rtol, atol, model, pts, idx, m, work, st):
+    """One accepted DOP853 step from local time t into st.y_new, with scipy's step-size
+    control: a rejected step shrinks by max(MIN_FACTOR, SAFETY err^(−1/8)), an accepted
+    one grows by at most MAX_FACTOR (not at all right after a rejection).  Returns
+    (t + h, h, the next step's h_abs, RHS evaluations); h = 0 when the step would fall below 10
+    roundoff units of t or the error norm is not finite."""
+    K, y_new, scale = st.K, st.y_new, st.scale
+    min_step = 10 * (math.nextafter(t, math.inf) - t)
+    rejected = False
+    nfev = 0
+    while True:
+        if h_abs < min_step:
+            return t, 0.0, h_abs, nfev
+        t_new = min(t + h_abs, s_end)
+        h = t_new - t
+        nfev += dop853_step(y, f, h, model, pts, idx, m, work, K, y_new, st.tmp)
+        for c in range(13):
+            scale[c] = atol[c] + max(abs(y[c]), abs(y_new[c])) * rtol
+        err = error_norm(K, h, scale)
+        if not math.isfinite(err):
+            return t, 0.0, h_abs, nfev
+        if err < 1.0:
+            factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
+            if rejected:
+                factor = min(1.0, factor)
+            return t_new, h, h * factor, nfev
+        h_abs = h * max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
+        rejected = True
+
+
+@njit(cache=True)
 def integrate_held(
     y,
     s_end,
@@ -282,29 +313,14 @@ def integrate_held(
     nfev += n0
     t = 0.0
     gi = 0
-    K, y_new, scale = st.K, st.y_new, st.scale
+    K, y_new = st.K, st.y_new
     while t < s_end:
-        min_step = 10 * (math.nextafter(t, math.inf) - t)
-        rejected = False
-        while True:
-            if h_abs < min_step:
-                return Integration(INT_FAILED, t, nfev, -1)
-            t_new = min(t + h_abs, s_end)
-            h = t_new - t
-            nfev += dop853_step(y, f, h, model, pts, idx, m, work, K, y_new, st.tmp)
-            for c in range(13):
-                scale[c] = atol[c] + max(abs(y[c]), abs(y_new[c])) * rtol
-            err = error_norm(K, h, scale)
-            if not math.isfinite(err):
-                return Integration(INT_FAILED, t, nfev, -1)
-            if err < 1.0:
-                factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**ERROR_EXPONENT)
-                if rejected:
-                    factor = min(1.0, factor)
-                h_abs = h * factor
-                break
-            h_abs = h * max(MIN_FACTOR, SAFETY * err**ERROR_EXPONENT)
-            rejected = True
+        t_new, h, h_abs, n_step = _accepted_step(
+            y, f, t, s_end, h_abs, rtol, atol, model, pts, idx, m, work, st
+        )
+        nfev += n_step
+        if h == 0.0:
+            return Integration(INT_FAILED, t, nfev, -1)
         for i in range(m):
             st.lam_new[i] = work.lam[i]
         leaving = _most_negative(st.lam_new, m) if watch_forces else -1

@@ -15,12 +15,25 @@ def solve_small(A, r, m, out):
         out[0] = r[0] / A[0, 0]
         return True
     if m == 2:
-        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        if det == 0.0:
-            return False
-        out[0] = (r[0] * A[1, 1] - r[1] * A[0, 1]) / det
-        out[1] = (r[1] * A[0, 0] - r[0] * A[1, 0]) / det
-        return True
+        return _solve_2(A, r, out)
+    return _solve_3(A, r, out)
+
+
+@njit(cache=True)
+def _solve_2(A, r, out):
+    """Cramer's rule for a 2 × 2 system."""
+    det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+    if det == 0.0:
+        return False
+    out[0] = (r[0] * A[1, 1] - r[1] * A[0, 1]) / det
+    out[1] = (r[1] * A[0, 0] - r[0] * A[1, 0]) / det
+    return True
+
+
+@njit(cache=True)
+def _solve_3(A, r, out):
+    """Gaussian elimination with partial pivoting for a 3 × 3 system, then back
+    substitution."""
     M = A[:3, :3].copy()
     v = r[:3].copy()
     for c in range(3):
