@@ -104,6 +104,21 @@ HC_MIN_RESTITUTION = 0.01
 FALL_THROUGH_DEPTH = FACE_HALF_THICKNESS_FRACTION
 
 
+class _HalfSpaceNotice(logging.Filter):
+    """Drops SceneGraph's notice that a rigid half space takes no part in deformable
+    contact (there is no deformable body here); every other Drake message passes."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return "half spaces are not currently supported for deformable" not in record.getMessage()
+
+
+def _quiet_half_space_warning() -> None:
+    """Install the filter on pydrake's Python logger "drake" once."""
+    logger = logging.getLogger("drake")
+    if not any(isinstance(f, _HalfSpaceNotice) for f in logger.filters):
+        logger.addFilter(_HalfSpaceNotice())
+
+
 @dataclass(frozen=True)
 class DrakeSettings:
     """Everything a profile chooses."""
@@ -312,35 +327,27 @@ def build_model(scene: Scene, settings: DrakeSettings) -> DrakeModel:
     contact_of = {}
     points = scene_points(scene)
     world = plant.world_body()
-    # SceneGraph warns that a rigid half space takes no part in deformable contact
-    # (there is none here): silence the registration only (pydrake logs through the
-    # Python logger "drake").
-    logger = logging.getLogger("drake")
-    old = logger.level
-    logger.setLevel(logging.ERROR)
-    try:
-        if scene.ground.kind == "flat":
-            for k, p in enumerate(points):
-                gid = plant.RegisterCollisionGeometry(
-                    body, RigidTransform(p), Sphere(r), f"vertex{k}", on_body
-                )
-                contact_of[gid] = k
-            plant.RegisterCollisionGeometry(
-                world, RigidTransform([0.0, 0.0, -r]), HalfSpace(), "ground", on_ground
+    _quiet_half_space_warning()
+    if scene.ground.kind == "flat":
+        for k, p in enumerate(points):
+            gid = plant.RegisterCollisionGeometry(
+                body, RigidTransform(p), Sphere(r), f"vertex{k}", on_body
             )
-        else:
-            hh = FACE_HALF_THICKNESS_FRACTION * b.radius
-            side = 2.0 * b.radius
-            plant.RegisterCollisionGeometry(
-                body, RigidTransform([0.0, 0.0, r + hh]), Box(side, side, 2 * hh), "face", on_body
+            contact_of[gid] = k
+        plant.RegisterCollisionGeometry(
+            world, RigidTransform([0.0, 0.0, -r]), HalfSpace(), "ground", on_ground
+        )
+    else:
+        hh = FACE_HALF_THICKNESS_FRACTION * b.radius
+        side = 2.0 * b.radius
+        plant.RegisterCollisionGeometry(
+            body, RigidTransform([0.0, 0.0, r + hh]), Box(side, side, 2 * hh), "face", on_body
+        )
+        for k, p in enumerate(points):
+            gid = plant.RegisterCollisionGeometry(
+                world, RigidTransform(p), Sphere(r), f"bump{k}", on_ground
             )
-            for k, p in enumerate(points):
-                gid = plant.RegisterCollisionGeometry(
-                    world, RigidTransform(p), Sphere(r), f"bump{k}", on_ground
-                )
-                contact_of[gid] = k
-    finally:
-        logger.setLevel(old)
+            contact_of[gid] = k
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -scene.gravity])
     plant.Finalize()
     return DrakeModel(builder.Build(), plant, body, contact_of, settings)
