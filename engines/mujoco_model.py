@@ -182,7 +182,7 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> ContactSettings:
 
 def contact_geom_pairs(scene: Scene) -> list[tuple[str, str]]:
     """(geom1, geom2) names of contact k: vertex k/ground on flat, bump k/face on
-    three_point (CONTRACT.md's contact numbering)."""
+    three_point (the contact numbering of docs/contract.md)."""
     if scene.ground.kind == "three_point":
         return [(f"bump{k}", "face") for k in range(3)]
     return [(f"vertex{k}", "ground") for k in range(scene.body.n)]

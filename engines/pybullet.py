@@ -1,7 +1,7 @@
 """PyBullet model of a scene: the same body and ground, frictionless point contacts,
 run at a fixed step and returned as a `Trajectory` in the reference's conventions.
 
-Geometry (DESIGN.md §4, docs/engines.md "Geometry that is exactly a point contact"):
+Geometry (docs/engines.md "Geometry that is exactly a point contact"):
 
 - `flat`: one `<collision><sphere>` of radius r at every vertex, in a URDF (the
   collision-shape-array API keeps only 16 shapes), and the ground plane lowered by r.

@@ -1,7 +1,7 @@
 """Scenes: the problem statement, validated into immutable data.
 
 A scene is a regular n-gon (or a disk on three ground bumps), its ground, its initial
-state and how long to run.  The TOML layout is fixed by CONTRACT.md; this module turns
+state and how long to run.  The TOML layout is public (docs/contract.md); this module turns
 a parsed mapping into a frozen :class:`Scene` and rejects bad input with
 :class:`SceneError` (one clear sentence, never a traceback at the CLI).
 
@@ -134,7 +134,7 @@ class Scene:
 
     def scaled(self, eps: float, name: str = "--scale") -> Scene:
         """Apply the paper's scaling invariance to the linear initial coordinates:
-        q → ε² q, p → ε p (section 2.5).  Only defined for scenes given by (q, p).
+        q → ε² q, p → ε p (section 2.6).  Only defined for scenes given by (q, p).
         The result passes the same checks as a scene file (check_scene), the
         below-ground check included."""
         if self.initial.q is None or self.initial.p is None:
@@ -151,7 +151,7 @@ def scaled_initial(q, p, eps: float, name: str = "scale") -> InitialState:
 
 
 def initial_from_linear(q, p) -> InitialState:
-    """Map linear coordinates to a full state (CONTRACT.md): attitude = rotation vector
+    """Map linear coordinates to a full state (docs/contract.md): attitude = rotation vector
     (φx, φy, 0), centre of mass (0, 0, h), velocity (0, 0, v), ω = (ωx, ωy, 0)."""
     q = tuple(float(x) for x in q)
     p = tuple(float(x) for x in p)
@@ -213,7 +213,7 @@ def show_path(path: str | Path, limit: int = 80) -> str:
 
 
 def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
-    """Validate a parsed scene mapping (the TOML layout of CONTRACT.md) into a Scene:
+    """Validate a parsed scene mapping (the TOML layout of docs/contract.md) into a Scene:
     every field's type and range, then the checks of `check_scene`."""
     if not isinstance(data, dict):
         raise SceneError(f"a scene is a TOML table, got {type(data).__name__}")

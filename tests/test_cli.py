@@ -1,4 +1,4 @@
-"""The `harness` command as users and outside checks call it (CONTRACT.md)."""
+"""The `harness` command as users and outside checks call it (docs/contract.md)."""
 
 from __future__ import annotations
 

@@ -63,7 +63,7 @@ def test_elastic_energy_drift_over_10000_impacts_is_below_1e_12():
 
 
 def test_scaled_impact_times_keep_their_digits_deep_into_the_singularity():
-    """Scaling invariance (paper §2.5): with q·ε², p·ε the scaled impact times t_k/ε of
+    """Scaling invariance (paper §2.6): with q·ε², p·ε the scaled impact times t_k/ε of
     the full model converge to the linear model's as ε → 0, with differences O(ε²)
     (measured: they already agree to roundoff at ε = 1e-3 here).  Lost digits
     (1 − cos α, absolute time resolution) would make them scatter by ~1e-16/ε² instead,

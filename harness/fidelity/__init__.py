@@ -1,6 +1,6 @@
 """`harness fidelity`: down to which inclination α an engine follows the exact motion.
 
-The paper's scaling invariance (Baranyai & Várkonyi, section 2.5) maps a motion of the
+The paper's scaling invariance (Baranyai & Várkonyi, section 2.6) maps a motion of the
 linear model onto the same motion at any smaller inclination: q → ε²q, p → εp, t → εt.
 `Scene.scaled(ε)` applies it to a scene given in (q, p), and the study scales the
 scene's t_end by ε too.  At a smaller ε the same impacts come ε times closer together in

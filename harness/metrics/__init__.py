@@ -1,4 +1,5 @@
-"""Metrics of one simulator run against the reference (CONTRACT.md, `compare`).
+"""Metrics of one simulator run against the reference (`harness compare`; docs/contract.md,
+docs/output.md).
 
 Every function here is a plain function of Trajectories: `run` (an engine, the linear
 model, or the reference itself) and `reference` (the exact event-driven solution).  They
@@ -6,7 +7,7 @@ compare the two over their *common window* [max of the first sample times, min o
 last sample times]: the reference may stop early (singularity, undecidable simultaneous
 impact) and an engine may fail.
 
-Facts of the exact model that the definitions rely on (DESIGN.md §2):
+Facts of the exact model that the definitions rely on (docs/architecture.md, "The model"):
 - the attitude is continuous in time (impacts change velocities only), so it can be
   interpolated across impacts;
 - the energy is constant in flight and in frictionless sustained contact and jumps down

@@ -1,4 +1,5 @@
-"""Agreement of a full simulator with the linearised model as α → 0 (DESIGN.md §3).
+"""Agreement of a full simulator with the linearised model as α → 0 (paper §2.4–2.6;
+docs/glossary.md, ε).
 
 A scene given by (q, p) is scaled by ε (q → ε² q, p → ε p, hence α = O(ε²)) and run with
 the full simulator; by the scaling invariance the linear model's answer is the unscaled

@@ -15,7 +15,7 @@ positive root of one; roots are taken in cancellation-free form (`first_hit`).  
 
 Scaling.  The state is kept normalised with two exact powers of two, q = 2^kq q̃,
 p = 2^kv p̃, t = 2^(kq−kv) t̃.  The normalised system is the same model with gravity
-g̃ = 2^(kq−2kv) g (the scaling invariance of section 2.5 when kq = 2kv; with gravity
+g̃ = 2^(kq−2kv) g (the scaling invariance of section 2.6 when kq = 2kv; with gravity
 negligible, as in gravity-free chatter where gaps shrink faster than p²/g, the two
 scales separate).  kv keeps the energy Ẽ = ½ p̃ᵀΘp̃ + m g̃ h̃ (true E = 4^kv Ẽ) in [½, 2),
 kq keeps the gaps O(1).  Multiplying by powers of two costs no digits, so runs follow

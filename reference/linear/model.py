@@ -138,7 +138,7 @@ class LinearModel:
     def from_scene(cls, scene) -> LinearModel:
         """Flat ground: vertices of the n-gon.  `three_point`: the bumps at radius b,
         with the body's inertia m (ρ a)² (a = body radius): in units of b the gyration
-        is ρ a / b (DESIGN.md §3)."""
+        is ρ a / b (docs/glossary.md, ρ)."""
         body = scene.body
         i1 = body.inertia_diag[0]
         if scene.ground.kind == "three_point":
@@ -203,7 +203,7 @@ def linear_state(scene) -> tuple[np.ndarray, np.ndarray]:
 def full_states(q: np.ndarray, p: np.ndarray) -> np.ndarray:
     """(N, 13) full states [x, quaternion wxyz, v, ω world] of linear states (N, 3) each:
     attitude = rotation vector (φx, φy, 0), centre (0, 0, h), velocity (0, 0, v),
-    ω = (ωx, ωy, 0) (CONTRACT.md)."""
+    ω = (ωx, ωy, 0) (docs/contract.md)."""
     q = np.atleast_2d(q)
     p = np.atleast_2d(p)
     N = len(q)

@@ -3,7 +3,7 @@
 `run_linear` drives the compiled event loop of `kernel.py` (motion between events is
 quadratic in time, events are roots of quadratics, impacts are the maps U_k) and returns
 the events with true (unscaled) states.  `simulate_linear` turns a scene into such a run
-and maps it to full states (CONTRACT.md): attitude = rotation vector (φx, φy, 0), centre
+and maps it to full states (docs/contract.md): attitude = rotation vector (φx, φy, 0), centre
 (0, 0, h), velocity (0, 0, v), ω = (ωx, ωy, 0).  `run_linear_exponent` is the one-sample
 energy-exponent run of the paper's section 4.3.
 """
@@ -239,7 +239,7 @@ def simulate_linear(
     Energies are the linear model's own quadratic form, KE = ½ pᵀΘp and PE = m g h,
     because it is the quantity the linear dynamics conserves exactly between impacts
     (so energy-drift metrics see the model, not the mapping); it differs from
-    reference.body.BodyModel's energy of the mapped full state by ½ (I3 − I1)(ω·e3)²
+    reference.geometry.energies of the mapped full state by ½ (I3 − I1)(ω·e3)²
     with ω·e3 = ωx φy − ωy φx, i.e. by O(α²) relative.
 
     Status as the reference: simultaneous_impact when undecidable, singularity when all

@@ -3,7 +3,7 @@
 State vector (13): position x (3), quaternion q = (w, x, y, z) body → world (4),
 velocity v (3), angular velocity ω in the world frame (3).
 
-Contacts (DESIGN.md §2):
+Contacts (docs/architecture.md, "The model"):
 - `flat`: contact k is vertex k, r_k = R a(cos 2πk/n, sin 2πk/n, 0); gap = z + (r_k)_z;
   normal e_z.
 - `three_point`: contact k is the bump at b_k = b(cos 2πk/3, sin 2πk/3, 0); the body's

@@ -1,4 +1,4 @@
-"""Oracle: sustained contact (paper §2.2, eqs. rollF, rollM, rollc; DESIGN.md §2).
+"""Oracle: sustained contact (paper §2.2, eqs. rollF, rollM, rollc).
 
 With a set C of contacts held (gap 0, normal velocity 0), the normal accelerations are
 a_n = A λ + b with A = J M⁻¹ Jᵀ and b = J M⁻¹ f + bias (gravity, gyroscopic term and

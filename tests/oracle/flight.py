@@ -1,4 +1,4 @@
-"""Oracle: free flight in closed form (DESIGN.md §2, paper eqs. acc1free–acc2free).
+"""Oracle: free flight in closed form (paper §2.2, eqs. acc1free–acc2free).
 
 The centre of mass follows a parabola, x(s) = x0 + v0 s − ½ g s² e_z.  The body is
 axisymmetric (I1 = I2 = A, I3 = C), so torque-free rotation is regular precession: the

@@ -23,7 +23,7 @@ the motion.  The run stops with an explicit `Status` and never guesses:
 Time is kept as a double-double (t_hi + t_lo) and every phase is computed in its own
 local time, so that intervals near the singularity keep all their digits.
 
-Chatter (0 < γ < 1, DESIGN.md §2): after an impact whose post-impact normal velocity u
+Chatter (0 < γ < 1, docs/architecture.md): after an impact whose post-impact normal velocity u
 is below `chatter_tol` times the body's velocity scale V while the contact point falls
 back (normal acceleration a_n < 0), the remaining infinite sequence of impacts is
 completed: u is removed by a normal impulse and the contact is held.  The exact sequence
