@@ -266,6 +266,8 @@ def _trajectory(
     state = p.state[0]
     status, message = status_message(state, p.options[0])
     t_sing = float(state["t_singularity"])
+    if int(state["status"]) == R.STATUS_AT_REST:
+        t_sing = float(state["info_t"])  # at rest from the start: the motion ended there
     stats = RunStats.from_counters(
         p.counters[0],
         wall,

@@ -44,3 +44,26 @@ def test_a_tilt_decaying_below_the_floor_ends_at_the_singularity(name):
     assert traj.inclination[-1] < 1e-149  # the last sample is at the floor
     assert traj.t_singularity >= traj.t_final
     assert all(math.isfinite(x) for x in traj.energy)
+
+
+def test_singularity_time_is_extrapolated_over_alternating_intervals():
+    """A triangle's vertices take turns: its intervals alternate (A qʲ, B qʲ), so single
+    ratios swing about 1 while pairs shrink by q.  The extrapolated t_f is the sum of the
+    whole geometric series, t_0 + (A + B)/(1 − q)."""
+    from collections import namedtuple
+
+    import numpy as np
+
+    from reference.core.loop import extrapolate_singularity
+    from reference.core.records import N_IMPACTS
+
+    A, B, q, n = 1e-3, 1.3e-3, 0.7, 13
+    tau = [(A if k % 2 == 0 else B) * q ** (k // 2) for k in range(n - 1)]
+    t = np.concatenate([[0.5], 0.5 + np.cumsum(tau)])
+    impacts = np.zeros((n, 6))
+    impacts[:, 0] = t
+    counts = np.zeros(8, dtype=np.int64)
+    counts[N_IMPACTS] = n
+    out = namedtuple("Out", "counts impacts")(counts, impacts)
+    t_f = extrapolate_singularity(out, t[-1])
+    assert t_f == pytest.approx(0.5 + (A + B) / (1 - q), rel=0, abs=1e-14)

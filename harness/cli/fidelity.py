@@ -33,39 +33,39 @@ def register(sub) -> None:
     f.add_argument(
         "--eps-grid",
         type=grid,
-        default=DEFAULT_EPS_GRID,
+        default=f"{a:g}:{b:g}:{k}",  # argparse converts a string default with `type`
         metavar="A:B:K",
-        help=f"K scales from A to B, log-spaced (default {a:g}:{b:g}:{k})",
+        help="K scales from A to B, log-spaced",
     )
     f.add_argument(
         "--leading",
         type=int_in(1, 10**6),
         default=DEFAULT_LEADING,
-        help=f"leading impacts of the reference to match (default {DEFAULT_LEADING})",
+        help="leading impacts of the reference to match",
     )
     f.add_argument(
         "--match-fraction",
         type=fraction,
         default=DEFAULT_MATCH_FRACTION,
-        help=f"fraction of them a run must match (default {DEFAULT_MATCH_FRACTION:g})",
+        help="fraction of them a run must match",
     )
     f.add_argument(
         "--c-tolerance",
         type=positive_float,
         default=DEFAULT_C_TOLERANCE,
-        help=f"relative tolerance on c where both runs have one (default {DEFAULT_C_TOLERANCE:g})",
+        help="relative tolerance on c where both runs have one",
     )
     f.add_argument(
         "--window",
         choices=WINDOWS,
         default="leading",
-        help="run engines just past the leading impacts (default) or to the reference's end",
+        help="run engines just past the leading impacts, or to the reference's end",
     )
     f.add_argument(
         "--budget",
         type=positive_float,
         default=DEFAULT_BUDGET_S,
-        help=f"seconds per run (default {DEFAULT_BUDGET_S:g}; predicted, skipped above it)",
+        help="seconds per run (predicted, skipped above it)",
     )
     f.add_argument("--plot", metavar="FILE.png", help="alpha* against dt with the fitted k")
     f.add_argument("--out", metavar="FILE.json", help="also write the JSON document here")

@@ -40,7 +40,7 @@ from .records import (
     STATUS_T_END,
     STATUS_TILT_FLOOR,
 )
-from .tolerances import TILT_FLOOR
+from .tolerances import MAX_PERIOD, PERIOD_RATIO_TOL, TILT_FLOOR
 from .workspace import new_contact_lists
 
 # rows every step may add at most to impacts, phases and accumulation times
@@ -48,19 +48,34 @@ STEP_ROWS = 4
 
 
 @njit(cache=True)
+def _span(imp, i, j):
+    """Time from impact i to impact j (double-double differences)."""
+    return (imp[j, 0] - imp[i, 0]) + (imp[j, 1] - imp[i, 1])
+
+
+@njit(cache=True)
 def extrapolate_singularity(out, t_hi):
-    """t_f from the last three impacts, assuming geometric intervals τ_{k+1} = r τ_k:
-    t_f = t_3 + τ_2 r/(1 − r); the current time when that does not apply."""
+    """t_f from the last impacts, assuming geometric intervals with a period of m
+    impacts (m = 1 … MAX_PERIOD: the vertices of a polygon often take turns, so single
+    intervals alternate while blocks of m shrink by a constant ratio r): the smallest m
+    whose last two block ratios agree to PERIOD_RATIO_TOL, with r < 1, gives
+    t_f = t_last + S r/(1 − r), S the last block's duration.  The current time when no
+    m applies."""
     n = out.counts[N_IMPACTS]
-    if n < 3:
-        return t_hi
-    a, b, c = out.impacts[n - 3], out.impacts[n - 2], out.impacts[n - 1]
-    tau1 = (b[0] - a[0]) + (b[1] - a[1])
-    tau2 = (c[0] - b[0]) + (c[1] - b[1])
-    if tau1 <= 0 or not 0 < tau2 / tau1 < 1:
-        return t_hi
-    r = tau2 / tau1
-    return c[0] + (c[1] + tau2 * r / (1 - r))
+    imp = out.impacts
+    last = n - 1
+    for m in range(1, MAX_PERIOD + 1):
+        if n < 3 * m + 1:
+            break
+        s1 = _span(imp, last - m, last)
+        s0 = _span(imp, last - 2 * m, last - m)
+        s_1 = _span(imp, last - 3 * m, last - 2 * m)
+        if not (s0 > 0 and s_1 > 0 and s1 > 0):
+            continue
+        r, r_before = s1 / s0, s0 / s_1
+        if r < 1 and abs(r - r_before) <= PERIOD_RATIO_TOL * r:
+            return imp[last, 0] + (imp[last, 1] + s1 * r / (1 - r))
+    return t_hi
 
 
 @njit(cache=True)

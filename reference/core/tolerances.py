@@ -81,3 +81,10 @@ LOCATE_ITERATIONS = 200
 # decide anything further (a sweep run reached α = 4e-296 and divided by zero).  An
 # exactly flat body (α = 0, e.g. landing flat) is left to the event search.
 TILT_FLOOR = 1e-150
+
+# t_singularity extrapolated from the last impacts (loop.extrapolate_singularity): blocks
+# of up to MAX_PERIOD impacts, accepted when the last two blocks' ratios agree to
+# PERIOD_RATIO_TOL (relative).  A triangle's vertices take turns: its single intervals
+# alternate (ratios 0.81, 1.09, ...) while pairs shrink by 0.86 each.
+MAX_PERIOD = 6
+PERIOD_RATIO_TOL = 0.05

@@ -8,3 +8,13 @@
 - exponent:    the energy exponent c (regression on log(t_f − t), decade durations, period)
 - alpha:       agreement of a full simulator with the linear model as α → 0
 """
+
+
+def __getattr__(name: str):
+    """`from reference.linear import simulate_linear` (the public API), loaded on first
+    use so that importing the package does not compile the linear kernel."""
+    if name in ("simulate_linear", "run_linear", "run_linear_exponent"):
+        from . import simulate
+
+        return getattr(simulate, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

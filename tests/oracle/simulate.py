@@ -293,18 +293,30 @@ def _all_down(model: BodyModel, active: list[int]) -> bool:
     return len(active) >= need
 
 
-def _extrapolate_singularity(run: _Run) -> float:
-    """t_f from the last three impacts assuming geometric intervals τ_{k+1} = r τ_k."""
+def _extrapolate_singularity(run: _Run, max_period: int = 6, tol: float = 0.05) -> float:
+    """t_f from the last impacts assuming geometric intervals with a period of m impacts
+    (the smallest m ≤ max_period whose last two block ratios r agree to `tol` with
+    r < 1): t_f = t_last + S r/(1 − r), S the last block's duration."""
     imp = run.impacts
-    if len(imp) < 3:
-        return run.clock.hi
-    t = [(e.t, e.t_lo) for e in imp[-3:]]
-    tau1 = (t[1][0] - t[0][0]) + (t[1][1] - t[0][1])
-    tau2 = (t[2][0] - t[1][0]) + (t[2][1] - t[1][1])
-    if tau1 <= 0 or not 0 < tau2 / tau1 < 1:
-        return run.clock.hi
-    r = tau2 / tau1
-    return t[2][0] + (t[2][1] + tau2 * r / (1 - r))
+
+    def span(i: int, j: int) -> float:
+        return (imp[j].t - imp[i].t) + (imp[j].t_lo - imp[i].t_lo)
+
+    last = len(imp) - 1
+    for m in range(1, max_period + 1):
+        if len(imp) < 3 * m + 1:
+            break
+        s1, s0, s_1 = (
+            span(last - m, last),
+            span(last - 2 * m, last - m),
+            span(last - 3 * m, last - 2 * m),
+        )
+        if not (s0 > 0 and s_1 > 0 and s1 > 0):
+            continue
+        r, r_before = s1 / s0, s0 / s_1
+        if r < 1 and abs(r - r_before) <= tol * r:
+            return imp[last].t + (imp[last].t_lo + s1 * r / (1 - r))
+    return run.clock.hi
 
 
 # ----------------------------------------------------------------------------- phases
