@@ -356,7 +356,8 @@ def _sample_grid(run: _Run, state_at, s_end: float) -> None:
         k0 += 1
 
 
-def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float):
+# The oracle keeps the contact-phase algorithm in one piece, to be read against the paper.
+def _contact_phase(run: _Run, y: np.ndarray, active: list[int], remaining: float):  # noqa: C901
     model = run.model
     t0 = run.clock.hi
     E_start = model.energy(y)
