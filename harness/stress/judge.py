@@ -142,6 +142,65 @@ def unmatched_impacts(
     return missed, spurious, int(np.sum(keep_r))
 
 
+def _impact_comparison(run: Trajectory, reference: Trajectory, scene: Scene) -> dict[str, Any]:
+    """The impact fields of a row: unmatched counts (`unmatched_impacts`) and the
+    in-order match of `metrics.match_impacts` against the reference."""
+    row: dict[str, Any] = {}
+    counts = unmatched_impacts(run, reference, scene.gravity)
+    if counts is not None:
+        row["missed_impacts"], row["spurious_impacts"], counted = counts
+        row["reference_impacts_counted"] = counted
+    m = match_impacts(run, reference, match_tolerance(run, reference, scene.gravity))
+    row["reference_impacts"] = m.n_reference
+    row["impacts_matched"] = m.n_matched
+    row["first_mismatch"] = m.reason
+    return row
+
+
+def _run_failures(
+    run: Trajectory, row: dict[str, Any], reached: bool, error: str | None
+) -> list[str]:
+    """Why a run failed by itself: the exception it raised, NaN, status failed, or
+    stopping before t_end without a physics reason."""
+    failed = []
+    if error is not None:
+        failed.append(f"raised {error}")
+    if row["nan"]:
+        failed.append("NaN in the state")
+    if not row["finished"] and error is None:
+        if run.status is Status.FAILED:
+            failed.append(f"status failed: {run.message}")
+        elif not reached:
+            failed.append(f"stopped at t={run.t_final:.6g} before t_end={row['t_target']:.6g}")
+    return failed
+
+
+def _measurement_problems(row: dict[str, Any], exact: bool) -> tuple[list[str], list[str]]:
+    """(failed, degraded) reasons from the measurements: energy gain and penetration
+    against the thresholds (TOLERANCES for degraded), and impacts against the reference."""
+    failed, degraded = [], []
+    gain, depth, L = row["energy_gain"], row["max_penetration"], row["length_scale"]
+    gain_tol, depth_tol = TOLERANCES["reference" if exact else "approximate"]
+    if gain is not None and gain > FAILED_ENERGY_GAIN:
+        failed.append(f"energy gain {gain:.3g} > {FAILED_ENERGY_GAIN:g}")
+    elif gain is not None and gain > gain_tol:
+        degraded.append(f"energy gain {gain:.3g} > {gain_tol:g}")
+    if depth is not None and depth > FAILED_PENETRATION * L:
+        failed.append(f"penetration {depth:.3g} > {FAILED_PENETRATION:g} L (L={L:.3g})")
+    elif depth is not None and depth > depth_tol * L:
+        degraded.append(f"penetration {depth:.3g} = {depth / L:.3g} L > {depth_tol:g} L")
+    missed, spurious = row["missed_impacts"], row["spurious_impacts"]
+    counted = row.get("reference_impacts_counted")
+    if counted and missed == counted and row["finished"]:
+        failed.append(f"matched none of the reference's {counted} impacts")
+    if missed or spurious:
+        text = f"{missed} missed, {spurious} spurious impacts"
+        if row["first_mismatch"]:
+            text += f" (first mismatch: {row['first_mismatch']})"
+        degraded.append(text)
+    return failed, degraded
+
+
 def assess(
     run: Trajectory,
     reference: Trajectory | None,
@@ -185,42 +244,9 @@ def assess(
         "reference_impacts_counted": None,
     }
     if reference is not None and reference.n_samples and run.n_samples:
-        counts = unmatched_impacts(run, reference, scene.gravity)
-        if counts is not None:
-            row["missed_impacts"], row["spurious_impacts"], counted = counts
-            row["reference_impacts_counted"] = counted
-        m = match_impacts(run, reference, match_tolerance(run, reference, scene.gravity))
-        row["reference_impacts"] = m.n_reference
-        row["impacts_matched"] = m.n_matched
-        row["first_mismatch"] = m.reason
-    failed, degraded = [], []
-    if error is not None:
-        failed.append(f"raised {error}")
-    if nan:
-        failed.append("NaN in the state")
-    if not finished and error is None:
-        if run.status is Status.FAILED:
-            failed.append(f"status failed: {run.message}")
-        elif not reached:
-            failed.append(f"stopped at t={run.t_final:.6g} before t_end={t_target:.6g}")
-    gain_tol, depth_tol = TOLERANCES["reference" if exact else "approximate"]
-    if gain is not None and gain > FAILED_ENERGY_GAIN:
-        failed.append(f"energy gain {gain:.3g} > {FAILED_ENERGY_GAIN:g}")
-    elif gain is not None and gain > gain_tol:
-        degraded.append(f"energy gain {gain:.3g} > {gain_tol:g}")
-    if depth is not None and depth > FAILED_PENETRATION * L:
-        failed.append(f"penetration {depth:.3g} > {FAILED_PENETRATION:g} L (L={L:.3g})")
-    elif depth is not None and depth > depth_tol * L:
-        degraded.append(f"penetration {depth:.3g} = {depth / L:.3g} L > {depth_tol:g} L")
-    missed, spurious = row["missed_impacts"], row["spurious_impacts"]
-    counted = row.get("reference_impacts_counted")
-    if counted and missed == counted and finished:
-        failed.append(f"matched none of the reference's {counted} impacts")
-    if missed or spurious:
-        text = f"{missed} missed, {spurious} spurious impacts"
-        if row["first_mismatch"]:
-            text += f" (first mismatch: {row['first_mismatch']})"
-        degraded.append(text)
+        row.update(_impact_comparison(run, reference, scene))
+    failed, degraded = _measurement_problems(row, exact)
+    failed = _run_failures(run, row, reached, error) + failed
     notes = []
     if run.status is Status.SIMULTANEOUS_IMPACT:
         notes.append("stopped undecidable (simultaneous impact)")

@@ -294,65 +294,87 @@ def feasibility_checks(model: LinearModel, q0, p0, tau0: float, beta: float) -> 
     return checks
 
 
-def selfsimilar_solutions(model: LinearModel, with_stability: bool = True) -> list[SelfSimilar]:
-    """Every self-similar β in (0, 1): trivial (eigenvalues of R⁻¹U0) and nontrivial
-    (roots of N), each with its normalised state (|p0| = 1), feasibility and the
-    eigenvalues of the Jacobian of C̄ at it.  Sorted by β."""
-    if model.n_contacts < 3:
-        raise ValueError("self-similar motion is defined for n >= 3")
-    M = model.R.T @ model.U(0)
-    lam, vec = np.linalg.eig(M)
-    out: list[SelfSimilar] = []
+def _trivial_solution(model: LinearModel, beta: float, vec: np.ndarray) -> SelfSimilar:
+    """The trivial solution (τ0 = 0, q0 = 0) of a real eigenvalue β of R⁻¹U0 with
+    eigenvector `vec`: p0 normalised with vertex 0 approaching; marginally feasible when
+    the impact drives no other contact into the ground (all are at it, q0 = 0)."""
+    p0 = np.real(vec)
+    p0 = p0 / np.linalg.norm(p0)
+    if model.F[0] @ p0 > 0:
+        p0 = -p0
+    q0 = np.zeros(3)
+    pa = model.U(0) @ p0
+    marginal = bool(
+        model.F[0] @ p0 < 0 and all(model.F[k] @ pa >= -1e-12 for k in range(2, model.n_contacts))
+    )
+    checks = {
+        "approaching": bool(model.F[0] @ p0 < 0),
+        "tau_positive": False,
+        "non_penetration": marginal,
+        "beta_in_0_1": True,
+    }
+    return SelfSimilar(float(beta), True, 0.0, q0, p0, checks, False, marginal)
+
+
+def _trivial_solutions(model: LinearModel) -> tuple[list[SelfSimilar], list[float]]:
+    """The trivial solutions, one per real eigenvalue β of M = R⁻¹U0 in (0, 1) (module
+    docstring), and every real eigenvalue of M (which the nontrivial β must avoid)."""
+    lam, vec = np.linalg.eig(model.R.T @ model.U(0))
+    sols: list[SelfSimilar] = []
     real_eigs = []
     for i, z in enumerate(lam):
         if abs(z.imag) <= 1e-12 * max(1.0, abs(z)):
             real_eigs.append(z.real)
             if 1e-9 < z.real < 1:
-                p0 = np.real(vec[:, i])
-                p0 = p0 / np.linalg.norm(p0)
-                if model.F[0] @ p0 > 0:
-                    p0 = -p0
-                q0 = np.zeros(3)
-                pa = model.U(0) @ p0
-                # all contacts are at the ground (q0 = 0): none may be driven into it
-                marginal = bool(
-                    model.F[0] @ p0 < 0
-                    and all(model.F[k] @ pa >= -1e-12 for k in range(2, model.n_contacts))
-                )
-                checks = {
-                    "approaching": bool(model.F[0] @ p0 < 0),
-                    "tau_positive": False,
-                    "non_penetration": marginal,
-                    "beta_in_0_1": True,
-                }
-                out.append(SelfSimilar(float(z.real), True, 0.0, q0, p0, checks, False, marginal))
+                sols.append(_trivial_solution(model, z.real, vec[:, i]))
+    return sols, real_eigs
+
+
+def _nontrivial_betas(model: LinearModel, real_eigs: list[float]) -> list[float]:
+    """The real roots of N in (0, 1) (the paper's polynomial π, section 3.1), polished
+    on the gap condition, without duplicates and without eigenvalues of R⁻¹U0."""
     N = selfsimilar_polynomial(model)
     roots = N.roots() if N.degree() > 0 else np.zeros(0)
+
+    def is_eigenvalue(b: float) -> bool:
+        return any(abs(b - e) < 1e-9 for e in real_eigs)
+
     betas: list[float] = []
     for r in roots:
         if abs(r.imag) > 1e-6 * max(1.0, abs(r)):
             continue
         b = float(r.real)
-        if not (-1e-9 < b < 1 + 1e-9):
-            continue
-        if any(abs(b - e) < 1e-9 for e in real_eigs):
+        if not (-1e-9 < b < 1 + 1e-9) or is_eigenvalue(b):
             continue
         b = _polish(model, b)
-        if not (0 < b < 1) or any(abs(b - x) < 1e-10 for x in betas):
-            continue
-        if any(abs(b - e) < 1e-9 for e in real_eigs):
+        if not (0 < b < 1) or any(abs(b - x) < 1e-10 for x in betas) or is_eigenvalue(b):
             continue
         betas.append(b)
-    for b in betas:
-        q0, p0 = selfsimilar_state(model, b, 1.0)
-        tau0 = 1.0
-        s = 1.0 / np.linalg.norm(p0)
-        if model.F[0] @ p0 > 0:
-            # the member with approaching vertex 0 has τ0 < 0
-            s, tau0 = -s, -1.0
-        p0, q0, tau0 = p0 * s, q0 * s * s, tau0 * abs(s)
-        checks = feasibility_checks(model, q0, p0, tau0, b)
-        out.append(SelfSimilar(b, False, tau0, q0, p0, checks, all(checks.values())))
+    return betas
+
+
+def _nontrivial_solution(model: LinearModel, beta: float) -> SelfSimilar:
+    """The nontrivial solution of β normalised to |p0| = 1 (τ0 < 0 for the member with
+    vertex 0 approaching), with the feasibility checks of section 3.2."""
+    q0, p0 = selfsimilar_state(model, beta, 1.0)
+    tau0 = 1.0
+    s = 1.0 / np.linalg.norm(p0)
+    if model.F[0] @ p0 > 0:
+        # the member with approaching vertex 0 has τ0 < 0
+        s, tau0 = -s, -1.0
+    p0, q0, tau0 = p0 * s, q0 * s * s, tau0 * abs(s)
+    checks = feasibility_checks(model, q0, p0, tau0, beta)
+    return SelfSimilar(beta, False, tau0, q0, p0, checks, all(checks.values()))
+
+
+def selfsimilar_solutions(model: LinearModel, with_stability: bool = True) -> list[SelfSimilar]:
+    """Every self-similar β in (0, 1): trivial (eigenvalues of R⁻¹U0) and nontrivial
+    (roots of N), each with its normalised state (|p0| = 1), feasibility and the
+    eigenvalues of the Jacobian of C̄ at it (section 3.3).  Sorted by β."""
+    if model.n_contacts < 3:
+        raise ValueError("self-similar motion is defined for n >= 3")
+    out, real_eigs = _trivial_solutions(model)
+    out += [_nontrivial_solution(model, b) for b in _nontrivial_betas(model, real_eigs)]
     if with_stability:
         for sol in out:
             if sol.tau0 < 0:
