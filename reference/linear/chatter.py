@@ -30,6 +30,7 @@ import math
 
 import numpy as np
 
+from ..core.tolerances import TINY
 from ._text import CHATTER_LEGEND, table
 from .model import LinearModel
 
@@ -58,7 +59,7 @@ def pcc_property(model: LinearModel) -> bool:
     """U0 R U0 R⁻¹ has no complex eigenvalues (eq. PCCtriangle)."""
     A = model.U(0) @ model.R @ model.U(0) @ model.R.T
     lam = np.linalg.eigvals(A)
-    return bool(np.all(np.abs(lam.imag) <= 1e-12 * np.maximum(np.abs(lam), 1e-300)))
+    return bool(np.all(np.abs(lam.imag) <= 1e-12 * np.maximum(np.abs(lam), TINY)))
 
 
 def rod_betas(rho: float, gamma: float) -> tuple[float, float] | None:

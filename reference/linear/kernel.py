@@ -58,7 +58,7 @@ import math
 import numpy as np
 from numba import njit
 
-EPS = 2.220446049250313e-16
+from ..core.tolerances import EPS  # unit roundoff of a double (one definition)
 
 # The event loop's helpers allocate nothing: they are compiled inline into simulate_kernel
 # (LLVM alwaysinline) and without reference counting (numba's own idiom for allocation-free

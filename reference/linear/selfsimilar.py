@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.polynomial import Polynomial as P
 
+from ..core.tolerances import TINY
 from ._text import SELFSIMILAR_LEGEND, table
 from .kernel import first_hit
 from .model import LinearModel
@@ -260,7 +261,7 @@ def feasibility_checks(model: LinearModel, q0, p0, tau0: float, beta: float) -> 
     pa = U0 @ p0
     n = model.n_contacts
     scale_q = float(np.max(np.abs(F) @ (np.abs(q0) + np.abs(pa) * tau0 + np.abs(a) * tau0**2)))
-    tol = FEAS_TOL * max(scale_q, 1e-300)
+    tol = FEAS_TOL * max(scale_q, TINY)
     ok_pen = True
     for k in range(n):
         if k == 0 and model.restitution == 0.0:
