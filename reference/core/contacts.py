@@ -13,14 +13,13 @@ tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
 
 import math
 
-from numba import njit
-
+from .jit import hot
 from .records import Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
 from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
 
 
-@njit(cache=True)
+@hot
 def vertex_lever(y, px, py):
     """r = R p of the body point p = (px, py, 0): its position from the centre of mass in
     the world frame (r_z from the small quaternion components: tilts keep their digits)."""
@@ -28,7 +27,7 @@ def vertex_lever(y, px, py):
     return R00 * px + R01 * py, R10 * px + R11 * py, R20 * px + R21 * py
 
 
-@njit(cache=True)
+@hot
 def vertex_frame(y, px, py):
     """Frame of the body point (px, py, 0) over flat ground: gap z + r_z, normal e_z,
     lever r, roundoff GAP_NOISE_ULPS ε (|z| + |r_z|)."""
@@ -36,14 +35,14 @@ def vertex_frame(y, px, py):
     return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[2], rz))
 
 
-@njit(cache=True)
+@hot
 def vertex_gap_noise(z, rz):
     """Roundoff of a vertex gap z + r_z: GAP_NOISE_ULPS ε (|z| + |r_z|) (|r_z| ≤ a bounds
     it for every vertex)."""
     return GAP_NOISE_ULPS * EPS * (abs(z) + abs(rz))
 
 
-@njit(cache=True)
+@hot
 def bump_frame(y, bx, by, bz):
     """Frame of the ground bump b under the body's face: gap d·e3 (d = x − b), normal e3,
     lever −d + gap e3, roundoff GAP_NOISE_ULPS ε Σ|d_j e3_j|."""
@@ -54,7 +53,7 @@ def bump_frame(y, bx, by, bz):
     return Frame(gap, ex, ey, ez, -dx + gap * ex, -dy + gap * ey, -dz + gap * ez, noise)
 
 
-@njit(cache=True)
+@hot
 def contact_frame(y, flat, pts, k):
     """Gap, normal, lever and gap roundoff of contact k at state y."""
     if flat:
@@ -62,7 +61,7 @@ def contact_frame(y, flat, pts, k):
     return bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
-@njit(cache=True)
+@hot
 def normal_velocity(y, f, flat):
     """g′ = n·(v + ω × r) of the contact with frame f (flat ground: v_z + (ω × r)_z)."""
     wx, wy, wz = y[10], y[11], y[12]
@@ -74,7 +73,7 @@ def normal_velocity(y, f, flat):
     return f.nx * (y[7] + cx) + f.ny * (y[8] + cy) + f.nz * (y[9] + cz)
 
 
-@njit(cache=True)
+@hot
 def vertex_normal_acceleration(y, f, acc):
     """g″ = v̇_z + (ω̇ × r)_z + (ω × (ω × r))_z of a vertex over flat ground, with
     (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z."""
@@ -87,7 +86,7 @@ def vertex_normal_acceleration(y, f, acc):
     )
 
 
-@njit(cache=True)
+@hot
 def bump_normal_acceleration(y, f, acc, bx, by, bz):
     """g″ = n·v̇ + (r × n)·ω̇ + 2 v·(ω × e3) + d·(ω × (ω × e3)) of a bump, d = x − b."""
     wx, wy, wz = y[10], y[11], y[12]
@@ -100,7 +99,7 @@ def bump_normal_acceleration(y, f, acc, bx, by, bz):
     return lin + 2.0 * (y[7] * ux + y[8] * uy + y[9] * uz) + dx * vx + dy * vy + dz * vz
 
 
-@njit(cache=True)
+@hot
 def normal_acceleration(y, f, acc, flat, pts, k):
     """g″ of contact k (frame f) for accelerations acc."""
     if flat:
@@ -108,7 +107,7 @@ def normal_acceleration(y, f, acc, flat, pts, k):
     return bump_normal_acceleration(y, f, acc, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
-@njit(cache=True)
+@hot
 def point_jet(y, px, py, acc):
     """Gap, rate, acceleration and roundoff of the body point (px, py, 0) over flat
     ground."""
@@ -116,7 +115,7 @@ def point_jet(y, px, py, acc):
     return Jet(f.gap, normal_velocity(y, f, True), vertex_normal_acceleration(y, f, acc), f.noise)
 
 
-@njit(cache=True)
+@hot
 def rim_jet(y, acc, radius):
     """Height, rate and acceleration of the body points (a, 0) and (0, a) less the
     centre's: (px, py, qx, qy, rx, ry).  A vertex at body direction c = (cos θ, sin θ)
@@ -128,7 +127,7 @@ def rim_jet(y, acc, radius):
     return jx.gap - z, jy.gap - z, jx.rate - vz, jy.rate - vz, jx.accel - acc[2], jy.accel - acc[2]
 
 
-@njit(cache=True)
+@hot
 def contact_jet(y, flat, pts, k, acc):
     """Gap, rate, acceleration and gap roundoff of contact k for accelerations acc."""
     if flat:
@@ -139,7 +138,7 @@ def contact_jet(y, flat, pts, k, acc):
     )
 
 
-@njit(cache=True)
+@hot
 def velocity_scale(y, radius):
     """V = |v| + a|ω|: the largest speed of a rim point (the local velocity unit)."""
     return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + radius * math.sqrt(
@@ -147,13 +146,13 @@ def velocity_scale(y, radius):
     )
 
 
-@njit(cache=True)
+@hot
 def rate_noise(y, radius):
     """Roundoff level of a normal velocity: RATE_NOISE_ULPS ε V."""
     return RATE_NOISE_ULPS * EPS * velocity_scale(y, radius)
 
 
-@njit(cache=True)
+@hot
 def length_scale(y, radius):
     """L = |z| + a sin α: the height of the centre plus the rim's vertical extent."""
     ex, ey, _ = body_axis(y)

@@ -11,14 +11,13 @@ constant, and
 
 import math
 
-from numba import njit
-
+from .jit import hot
 from .records import Bounds, FlightConstants
 from .rotation import body_axis, qmul, rotation_columns_xy, rotation_vector_quaternion
 from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS
 
 
-@njit(cache=True)
+@hot
 def flight_constants(y, i1, i3):
     """L/A, λ, |ω| and Ω of the free flight starting at state y."""
     e3x, e3y, e3z = body_axis(y)
@@ -31,7 +30,7 @@ def flight_constants(y, i1, i3):
     return FlightConstants(lax, lay, laz, lam, wabs, math.sqrt(lax * lax + lay * lay + laz * laz))
 
 
-@njit(cache=True)
+@hot
 def free_flight(y0, fc, gravity, s, out):
     """The state after a free flight of duration s from y0, into `out` (closed form)."""
     out[0] = y0[0] + y0[7] * s
@@ -52,7 +51,7 @@ def free_flight(y0, fc, gravity, s, out):
     out[12] = fc.laz + fc.lam * e3z
 
 
-@njit(cache=True)
+@hot
 def flight_acceleration(fc, y, gravity):
     """(v̇, ω̇) in flight: (0, 0, −g) and λ (L/A) × e3."""
     e3x, e3y, e3z = body_axis(y)
@@ -67,7 +66,7 @@ def flight_acceleration(fc, y, gravity):
     )
 
 
-@njit(cache=True)
+@hot
 def _height_terms(fx, fy, fz, Lx, Ly, Lz):
     """For a body axis f: (L̂·f) L̂_z, f_z − (L̂·f) L̂_z and (L̂ × f)_z, the constant, cosine
     and sine parts of (Rot(L̂, θ) f)_z (Rodrigues)."""
@@ -75,7 +74,7 @@ def _height_terms(fx, fy, fz, Lx, Ly, Lz):
     return lf * Lz, fz - lf * Lz, Lx * fy - Ly * fx
 
 
-@njit(cache=True)
+@hot
 def vertex_height_bounds(y0, fc, radius, gravity):
     """(K, B) ≥ max over the flight and over every vertex of |g″| and |g‴|, flat ground.
 
@@ -107,7 +106,7 @@ def vertex_height_bounds(y0, fc, radius, gravity):
     )
 
 
-@njit(cache=True)
+@hot
 def bump_gap_bounds(y0, fc, pts, gravity, horizon):
     """(K, B) for the three-point ground over a flight of `horizon`: with g = (x − b)·e3
     and e3 precessing at Ω about L,
@@ -129,7 +128,7 @@ def bump_gap_bounds(y0, fc, pts, gravity, horizon):
     return Bounds(BOUND_MARGIN * K, BOUND_MARGIN * B)
 
 
-@njit(cache=True)
+@hot
 def flight_bounds(y0, fc, model, pts, horizon):
     """(K, B) for the scene's ground (`vertex_height_bounds` or `bump_gap_bounds`)."""
     if model.flat_ground:

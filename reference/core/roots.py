@@ -12,17 +12,16 @@ lets the search pass it in a few steps."""
 
 import math
 
-from numba import njit
-
+from .jit import hot
 from .tolerances import ROOT_REL_TOL
 
 
-@njit(cache=True)
+@hot
 def _cubic_value(c0, c1, c2, c3, x):
     return c0 + x * (c1 + x * (c2 + x * c3))
 
 
-@njit(cache=True)
+@hot
 def _critical_points(c1, c2, c3):
     """The critical points of the cubic (roots of 3c3 x² + 2c2 x + c1),
     sorted: (count, first, second)."""
@@ -41,7 +40,7 @@ def _critical_points(c1, c2, c3):
     return 2, min(r0, r1), max(r0, r1)
 
 
-@njit(cache=True)
+@hot
 def _monotone_root(c0, c1, c2, c3, lo, hi):
     """A point below the root of the cubic on [lo, hi] (monotone there, positive at lo,
     ≤ 0 at hi), within ROOT_REL_TOL of it: safeguarded Newton from lo (from the middle
@@ -67,7 +66,7 @@ def _monotone_root(c0, c1, c2, c3, lo, hi):
     return lo
 
 
-@njit(cache=True)
+@hot
 def cubic_first_root(c0, c1, c2, c3, start=0.0):
     """First positive root of c0 + c1 x + c2 x² + c3 x³ (c0 > 0, c3 ≤ 0), from below
     within ROOT_REL_TOL; inf if there is none.  `start`: a point up to which the cubic is
@@ -94,7 +93,7 @@ def cubic_first_root(c0, c1, c2, c3, start=0.0):
     return math.inf
 
 
-@njit(cache=True)
+@hot
 def cubic_positive_on(c0, c1, c2, c3, T):
     """Whether the cubic (c0 > 0, c3 ≤ 0) stays positive on [0, T]: positive at T and at
     its local minimum (where the derivative turns from negative to positive) if that
@@ -117,7 +116,7 @@ def cubic_positive_on(c0, c1, c2, c3, T):
     return True
 
 
-@njit(cache=True)
+@hot
 def quadratic_first_root(g, g1, K):
     """First positive root of P2 = g + g1 δ − K δ²/2 (g > 0), in the cancellation-free
     form for g1's sign; inf if there is none."""
@@ -129,7 +128,7 @@ def quadratic_first_root(g, g1, K):
     return math.inf
 
 
-@njit(cache=True)
+@hot
 def quadratic_taylor_root(g, g1, g2):
     """First positive root of g + g1 δ + g2 δ²/2 (g > 0), cancellation-free; inf if
     none (B = 0 makes P3 this Taylor quadratic, in closed form)."""
@@ -144,7 +143,7 @@ def quadratic_taylor_root(g, g1, g2):
     return 2.0 * g / (sq - g1) if g1 < 0.0 else math.inf  # convex: the smaller root
 
 
-@njit(cache=True)
+@hot
 def safe_step(g, g1, g2, K, B, cap=math.inf):
     """First positive root of max(P2, P3): no contact before it; 0 if g ≤ 0.
 
@@ -166,7 +165,7 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
     return cubic_first_root(g, g1, c2, c3, d2)
 
 
-@njit(cache=True)
+@hot
 def _rising_cubic_root(c0, c1, c2, c3):
     """First positive root of c0 + c1 x + c2 x² + c3 x³ with c0 > 0, c1 < 0, c3 ≥ 0, as a
     point at or just past it (where the cubic is ≤ 0), within ROOT_REL_TOL; inf if the
@@ -199,7 +198,7 @@ def _rising_cubic_root(c0, c1, c2, c3):
     return hi
 
 
-@njit(cache=True)
+@hot
 def zero_bracket_end(g, g1, g2, K, B):
     """An end of a bracket [safe step, end] that holds the gap's first zero and no other,
     for a gap g > 0 approaching (g1 < 0): the first zero of an upper bound of the gap
@@ -218,7 +217,7 @@ def zero_bracket_end(g, g1, g2, K, B):
     return math.inf
 
 
-@njit(cache=True)
+@hot
 def _decreasing_until(g1, g2, K, B, end):
     """Whether a gap with rate g1 < 0, acceleration g2 and |g″| ≤ K, |g‴| ≤ B now is
     still decreasing at every time up to `end`: its rate is at most g1 + Kδ and

@@ -17,10 +17,9 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 
 import math
 
-from numba import njit
-
 from .contacts import contact_jet, rim_jet
 from .flight import flight_acceleration, free_flight
+from .jit import hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
 from .roots import safe_step, zero_bracket_end
 from .tolerances import (
@@ -42,7 +41,7 @@ from .window import use_window, vertex_window, window_offsets
 STEP, STEP_K, HIT_DS, HIT_K, LAND_K = range(5)
 
 
-@njit(cache=True)
+@hot
 def examine(y, acc, flat, pts, k, K, B, vnoise, res):
     """Examine contact k at state y: update res with its safe step, or record it as hit
     (touching and approaching faster than a graze) or landing (touching at rest,
@@ -66,7 +65,7 @@ def examine(y, acc, flat, pts, k, K, B, vnoise, res):
         res[STEP_K] = k
 
 
-@njit(cache=True)
+@hot
 def examine_window(y, acc, pts, n, K, B, k0, half, vnoise, res):
     """Examine vertices k0 − half … k0 + half (mod n, each once), centre first then
     outwards: the lowest usually bind the step, and a small step found early spares the
@@ -77,7 +76,7 @@ def examine_window(y, acc, pts, n, K, B, k0, half, vnoise, res):
         examine(y, acc, True, pts, k, K, B, vnoise, res)
 
 
-@njit(cache=True)
+@hot
 def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
     ux, uy = px + x * qx, py + x * qy
     return (
@@ -85,7 +84,7 @@ def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
     )
 
 
-@njit(cache=True)
+@hot
 def circle_step(y, acc, g, radius, B):
     """A step safe for every vertex at once, from the circle through them.
 
@@ -130,7 +129,7 @@ def circle_step(y, acc, g, radius, B):
     return lo, f0, pn
 
 
-@njit(cache=True)
+@hot
 def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res):
     """Examine the vertices near the lowest direction into res and return the cap on the
     step they certify (inf when none is needed).  The touching/lowest vertices and
@@ -156,7 +155,7 @@ def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res
     return dlt
 
 
-@njit(cache=True)
+@hot
 def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
     """One iteration's certified step (res holds hits and landings): every contact for
     small n or the three-point ground, else the circle bound or the vertices near the
@@ -191,7 +190,7 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
     return max(min(res[STEP], cap), d_c), last_dlt
 
 
-@njit(cache=True)
+@hot
 def _others_safe_until(y, acc, model, pts, k, end, K, B, windowed):
     """Whether every contact but k stays above the ground over [0, end] (its lower bound
     max(P2, P3) has no root before end; a touching contact is not certified).  With the
@@ -211,7 +210,7 @@ def _others_safe_until(y, acc, model, pts, k, end, K, B, windowed):
     return True
 
 
-@njit(cache=True)
+@hot
 def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
     """Contact k's single zero in [lo, hi] (gap > 0 at lo, ≤ 0 at hi, decreasing):
     Newton steps kept inside the shrinking bracket (bisection otherwise), until a step
@@ -234,7 +233,7 @@ def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
     return x
 
 
-@njit(cache=True)
+@hot
 def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, windowed, res, y):
     """The shortcut of a transversal approach: when the contact that sets the step
     (res[STEP_K]) is approaching with its first zero bracketed in [step, end]
@@ -259,7 +258,7 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     return -1.0
 
 
-@njit(cache=True)
+@hot
 def polish_impact(y0, fc, gravity, flat, pts, k, s_hit, y):
     """Newton steps on contact k's gap from s_hit; y ends at the polished time, which is
     returned."""
@@ -275,7 +274,7 @@ def polish_impact(y0, fc, gravity, flat, pts, k, s_hit, y):
     return s_hit
 
 
-@njit(cache=True)
+@hot
 def _candidates(y, model, pts, bounds, windowed):
     """The contacts that can be at the ground now: (first, half) of an index range
     around the lowest direction, every contact when half = n // 2."""
@@ -285,7 +284,7 @@ def _candidates(y, model, pts, bounds, windowed):
     return 0, n // 2
 
 
-@njit(cache=True)
+@hot
 def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together):
     """Contacts reached with k0 at state y (k0 first): approaching, with a zero within
     SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
@@ -309,7 +308,7 @@ def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together)
     return count
 
 
-@njit(cache=True)
+@hot
 def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     """Contacts touching at rest and accelerating into the ground at state y."""
     count = 0
@@ -324,7 +323,7 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     return count
 
 
-@njit(cache=True)
+@hot
 def find_flight_event(
     y0, fc, bounds, model, pts, window_search, horizon, max_iter, y, together, res
 ):
@@ -334,7 +333,8 @@ def find_flight_event(
     n = pts.shape[0]
     g = model.gravity
     windowed = use_window(model, window_search, n)
-    y[:] = y0
+    for c in range(13):  # (a slice copy would need numba's runtime: jit.hot)
+        y[c] = y0[c]
     s = 0.0
     vnoise = (
         RATE_NOISE_ULPS
