@@ -34,6 +34,9 @@ TEMP_PREFIX = ".harness-tmp-"
 DEFAULT_NAME_MAX = 255
 
 
+DEFAULT_RECORDING_FOLDER = Path("recordings")
+
+
 class OutputError(Exception):
     """An output that cannot or must not be written: one line, exit status 2."""
 
@@ -62,6 +65,15 @@ def check_writable(
             raise OutputError(f"{what} {show(p)} exists; use --force to replace it")
     _check_names(p, what)
     _probe_folder(p, what)
+    return p
+
+
+def recording_path(path: str | Path) -> Path:
+    """Where to write: a bare file name (no folder, not even ./) goes under recordings/.
+    Folders are created when the recording is written (harness.outputs.atomic_write)."""
+    p = Path(path)
+    if "/" not in str(path) and os.sep not in str(path):
+        p = DEFAULT_RECORDING_FOLDER / p
     return p
 
 

@@ -71,7 +71,7 @@ def run(args) -> int:
             check_run(e, scene, dt, args.t_end, args.max_steps)
     check_run("reference", scene, None, args.t_end)
     if args.record:
-        from ..recording import recording_path
+        from ..outputs import recording_path
 
         check_writable(recording_path(args.record), args.force, scene_inputs(args))
         check_distinct([recording_path(args.record), args.out])

@@ -56,7 +56,7 @@ def register(sub) -> None:
 def planned_outputs(args) -> list:
     """The files this run will write, as harness.outputs sees them."""
     from ..io import trajectory_paths
-    from ..recording import recording_path
+    from ..outputs import recording_path
 
     paths = trajectory_paths(args.out) if args.out else []
     if args.record:

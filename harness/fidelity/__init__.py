@@ -32,15 +32,27 @@ Definitions (all stated in the JSON document and the text output):
 
 from __future__ import annotations
 
-from .criteria import FidelityCriteria, alpha_star, power_law_fit  # noqa: F401
-from .plot import alpha_star_figure, matched_figure, save_figure  # noqa: F401
-from .study import (  # noqa: F401
-    DEFAULT_BUDGET_S,
-    DEFAULT_DTS,
-    DEFAULT_EPS_GRID,
-    WINDOWS,
-    default_engines,
-    eps_values,
-    fidelity,
-)
-from .text import format_fidelity  # noqa: F401
+from .settings import DEFAULT_BUDGET_S, DEFAULT_DTS, DEFAULT_EPS_GRID, WINDOWS  # noqa: F401
+
+# The study's functions load on first use (the CLI builds its parser from the settings
+# alone, without importing the bench, stress and metrics packages the study uses).
+_LAZY = {
+    "FidelityCriteria": "criteria",
+    "alpha_star": "criteria",
+    "power_law_fit": "criteria",
+    "alpha_star_figure": "plot",
+    "matched_figure": "plot",
+    "save_figure": "plot",
+    "default_engines": "study",
+    "eps_values": "study",
+    "fidelity": "study",
+    "format_fidelity": "text",
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -47,11 +47,8 @@ from ..stress.budget import (
 from .criteria import FidelityCriteria, alpha_star, exponent_check, impacts_pass, power_law_fit
 from .exponent import exponent_of
 from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
+from .settings import DEFAULT_BUDGET_S, DEFAULT_DTS, DEFAULT_EPS_GRID, WINDOWS  # noqa: F401
 
-DEFAULT_DTS = (1e-3, 1e-4, 1e-5)
-DEFAULT_EPS_GRID = (1.0, 1e-4, 17)  # first, last, count: log-spaced, α half a decade apart
-DEFAULT_BUDGET_S = 60.0  # per run
-WINDOWS = ("leading", "whole")
 NOT_ENGINES = ("reference", "linear")  # the default engines are every other one
 MESSAGE_CHARS = 300
 

@@ -19,7 +19,6 @@ No global recording is created.
 
 from __future__ import annotations
 
-import os
 import uuid
 from collections.abc import Callable
 from pathlib import Path
@@ -30,7 +29,8 @@ import rerun as rr
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
-from ..outputs import atomic_write
+from ..outputs import DEFAULT_RECORDING_FOLDER as DEFAULT_FOLDER  # noqa: F401
+from ..outputs import atomic_write, recording_path
 from .geometry import exaggeration_schedule
 from .layout import SUMMARY, RowRanges, build_blueprint, value_range
 from .raster import log_raster, raster_range
@@ -46,7 +46,6 @@ APPLICATION_ID = "euler_disk_harness"
 # The log rows open on their top 6 decades (a plot ~120 pixels high labels every
 # decade of 6, only every tenth of 9); the log-log plots on the right show all decades.
 ROW_DECADES = 6.0
-DEFAULT_FOLDER = Path("recordings")
 __all__ = [
     "APPLICATION_ID",
     "SIM_TIME",
@@ -55,15 +54,6 @@ __all__ = [
     "record_trajectories",
     "recording_path",
 ]
-
-
-def recording_path(path: str | Path) -> Path:
-    """Where to write: a bare file name (no folder, not even ./) goes under recordings/.
-    Folders are created when the recording is written (harness.outputs.atomic_write)."""
-    p = Path(path)
-    if "/" not in str(path) and os.sep not in str(path):
-        p = DEFAULT_FOLDER / p
-    return p
 
 
 def record_trajectories(
