@@ -166,6 +166,12 @@ def _error_text(exc: BaseException, limit: int = 2000) -> str:
     return text.strip()[-limit:]
 
 
+def engine_step(engine: str, dt: float | None) -> float | None:
+    """The timestep an engine runs with: `dt` (DEFAULT_DT when None) for a fixed-step
+    engine, None for an event-driven one."""
+    return (dt or DEFAULT_DT) if is_fixed_step(engine) else None
+
+
 def check_run(
     engine: str,
     scene: Scene,
@@ -188,9 +194,9 @@ def check_run(
         raise SceneError(
             f"engine {engine!r} takes polygons of at most {limit} vertices, got n = {scene.body.n}"
         )
-    if not is_fixed_step(engine):
+    step = engine_step(engine, dt)
+    if step is None:
         return None
-    step = dt or DEFAULT_DT
     horizon = scene.run.t_end
     if step > horizon:
         raise SceneError(f"--dt ({step:g}) must not exceed t_end ({horizon:g})")
@@ -221,7 +227,7 @@ def warm_up(engine: str, scene: Scene, dt: float | None = None) -> float:
     import time
 
     start = time.perf_counter()
-    step = (dt or DEFAULT_DT) if is_fixed_step(engine) else None
+    step = engine_step(engine, dt)
     t_short = WARM_UP_STEPS * step if step else WARM_UP_FRACTION * scene.run.t_end
     try:
         run_simulator(engine, scene, dt=step, t_end=min(t_short, scene.run.t_end))

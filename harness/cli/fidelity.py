@@ -7,6 +7,7 @@ from .common import (
     add_engine,
     add_force,
     add_json,
+    budget,
     emit,
     fraction,
     grid,
@@ -63,7 +64,7 @@ def register(sub) -> None:
     )
     f.add_argument(
         "--budget",
-        type=positive_float,
+        type=budget,
         default=DEFAULT_BUDGET_S,
         help="seconds per run (predicted, skipped above it)",
     )

@@ -21,7 +21,7 @@ import numpy as np
 import rerun as rr
 
 from .rows import time_column
-from .runs import MISMATCH_COLOR, RunView
+from .runs import RunView, mismatch_marker
 
 RASTER = "/impacts"
 IMPULSE_DECADES = 4.0  # marker size spans this many decades of impulse
@@ -106,12 +106,7 @@ def _log_mismatch(rec: rr.RecordingStream, run: RunView, base: float) -> None:
     path = f"{RASTER}/{run.name}/first_mismatch"
     rec.log(
         path,
-        rr.SeriesPoints(
-            colors=[MISMATCH_COLOR],
-            names=[f"{run.label}: first mismatch ({x.kind}), t = {x.t:.6g} s"],
-            markers=["cross"],
-            marker_sizes=[SIZE_MAX + 3],
-        ),
+        mismatch_marker(f"{run.label}: first mismatch ({x.kind}), t = {x.t:.6g} s", SIZE_MAX + 3),
         static=True,
     )
     t = x.t_run if x.t_run is not None else x.t_ref

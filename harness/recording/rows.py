@@ -39,7 +39,7 @@ from .geometry import (
     polygon_outline,
     quaternion_xyzw,
 )
-from .runs import MISMATCH_COLOR, RunView
+from .runs import RunView, mismatch_marker
 
 SIM_TIME = "sim_time"
 
@@ -109,12 +109,7 @@ def log_rows(rec: rr.RecordingStream, run: RunView) -> None:
             path = f"{root}/divergence/{key}"
             rec.log(
                 path,
-                rr.SeriesPoints(
-                    colors=[MISMATCH_COLOR],
-                    names=[f"{run.label}: first divergence, t = {t_div:.6g} s"],
-                    markers=["cross"],
-                    marker_sizes=[6.0],
-                ),
+                mismatch_marker(f"{run.label}: first divergence, t = {t_div:.6g} s", 6.0),
                 static=True,
             )
             y = float(np.interp(t_div, traj.t[ok], v[ok]))

@@ -31,6 +31,17 @@ PALETTE = [
     (140, 86, 75),
 ]
 MISMATCH_COLOR = (230, 40, 40)
+
+
+def mismatch_marker(label: str, size: float):
+    """The red cross that marks a run's first mismatch or divergence in every view."""
+    import rerun as rr
+
+    return rr.SeriesPoints(
+        colors=[MISMATCH_COLOR], names=[label], markers=["cross"], marker_sizes=[size]
+    )
+
+
 TIME_MARGIN = 0.1  # the recording runs to the reference's end × (1 + TIME_MARGIN)
 
 

@@ -45,6 +45,16 @@ class EndTime:
     what: str
 
 
+def _run_line(run: RunView, points) -> rr.LineStrips2D:
+    """A run's curve in the log-log plots: its colour, the reference drawn thinner."""
+    return rr.LineStrips2D(
+        [points],
+        colors=[run.color],
+        radii=rr.Radius.ui_points(1.0 if run.is_reference else 1.4),
+        draw_order=2.0,
+    )
+
+
 def end_time(reference: RunView) -> EndTime | None:
     """The reference's t_f: its fit's, its t_singularity, else its last impact."""
     traj = reference.trajectory
@@ -191,16 +201,7 @@ def _energy_curve(rec, run: RunView, ax: Axes, t, x, y) -> None:
     if len(x) == 0:
         return
     sx, sy = staircase(x, y)
-    rec.log(
-        f"{root}/staircase",
-        rr.LineStrips2D(
-            [ax.xy(sx, sy)],
-            colors=[run.color],
-            radii=rr.Radius.ui_points(1.0 if run.is_reference else 1.4),
-            draw_order=2.0,
-        ),
-        static=True,
-    )
+    rec.log(f"{root}/staircase", _run_line(run, ax.xy(sx, sy)), static=True)
     _fit_overlay(rec, run, ax, root)
     rec.log(
         f"{root}/now",
@@ -276,16 +277,7 @@ def log_alpha_plot(rec: rr.RecordingStream, runs: list[RunView], plot: Plot | No
         if len(x) == 0:
             continue
         root = f"{ALPHA}/{run.name}"
-        rec.log(
-            f"{root}/curve",
-            rr.LineStrips2D(
-                [ax.xy(x, y)],
-                colors=[run.color],
-                radii=rr.Radius.ui_points(1.0 if run.is_reference else 1.4),
-                draw_order=2.0,
-            ),
-            static=True,
-        )
+        rec.log(f"{root}/curve", _run_line(run, ax.xy(x, y)), static=True)
         rec.log(
             f"{root}/now",
             rr.Points2D.from_fields(radii=rr.Radius.ui_points(4.5), colors=[run.color]),
