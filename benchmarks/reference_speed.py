@@ -171,11 +171,12 @@ def sweep_ratio(samples: int) -> tuple[float, float, int]:
     """Mean seconds per run of the reference and the linear model on a 4 × 4 subgrid
     (ρ, γ from 0.2 to 0.8) of the paper's exponent map, `samples` initial states each."""
     from harness.sweep.grid import SweepConfig, grid_values, initial_state
-    from harness.sweep.run import run_linear_sample, run_trajectory_sample
+    from harness.sweep.run import sample_runner
 
     rhos, gammas = grid_values(0.2, 0.8, 4), grid_values(0.2, 0.8, 4)
     cost = {}
-    for engine, run in (("linear", run_linear_sample), ("reference", run_trajectory_sample)):
+    for engine in ("linear", "reference"):
+        run = sample_runner(engine)
         cfg = SweepConfig(n=3, engine=engine, gyration=(0.2, 0.8, 4),
                           restitution=(0.2, 0.8, 4), samples=samples, seed=1)  # fmt: skip
         run(cfg, 0.5, 0.5, *initial_state(1, 0, 0, 0))  # warm-up

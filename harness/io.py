@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from reference.trajectory import Trajectory
+from reference.trajectory import ImpactLog, Trajectory
 
 from .outputs import OutputError, atomic_outputs, atomic_write, check_writable, show
 
@@ -73,14 +73,7 @@ def write_trajectory_parquet(traj: Trajectory, path: str | Path, force: bool = F
     meta = {b"summary": json_text(traj.summary(with_impacts=False)).encode()}
     table = pa.table(cols).replace_schema_metadata(meta)
     imp = pa.table(
-        {
-            "t": pa.array([e.t for e in traj.impacts], type=pa.float64()),
-            "t_lo": pa.array([e.t_lo for e in traj.impacts], type=pa.float64()),
-            "contact": pa.array([e.contact for e in traj.impacts], type=pa.int64()),
-            "impulse": pa.array([e.impulse for e in traj.impacts], type=pa.float64()),
-            "v_normal_pre": pa.array([e.v_normal_pre for e in traj.impacts], type=pa.float64()),
-            "v_normal_post": pa.array([e.v_normal_post for e in traj.impacts], type=pa.float64()),
-        }
+        {name: pa.array(traj.impact_column(name)) for name in ImpactLog.COLUMNS}
     ).replace_schema_metadata(meta)
     with atomic_outputs(trajectory_paths(path), force) as (samples_tmp, impacts_tmp):
         pq.write_table(table, samples_tmp)

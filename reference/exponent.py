@@ -327,8 +327,7 @@ def pre_impact_samples(traj: Trajectory) -> np.ndarray:
     n_s = traj.n_samples
     t_s = np.asarray(traj.t, dtype=float)
     lo_s = np.zeros(n_s) if traj.t_lo is None else np.asarray(traj.t_lo, dtype=float)
-    t_i = np.array([e.t for e in traj.impacts])
-    lo_i = np.array([e.t_lo for e in traj.impacts])
+    t_i, lo_i = traj.impact_column("t"), traj.impact_column("t_lo")
     hi = np.concatenate([t_s, t_i])
     lo = np.concatenate([lo_s, lo_i])
     is_sample = np.concatenate([np.ones(n_s, dtype=bool), np.zeros(len(t_i), dtype=bool)])
@@ -408,8 +407,7 @@ def trajectory_exponent(
     E = np.asarray(traj.energy if energy is None else energy, dtype=float)
     if not E[0] > 0:
         return ExponentFit(reason="no energy above the resting level at the start")
-    t_i = np.array([e.t for e in imps])
-    lo_i = np.array([e.t_lo for e in imps])
+    t_i, lo_i = traj.impact_column("t"), traj.impact_column("t_lo")
     has_lo = traj.t_lo is not None or bool(np.any(lo_i != 0))
     tol = resolution if resolution is not None else (1e-28 if has_lo else 1e-13)
     idx = pre_impact_samples(traj)

@@ -66,17 +66,21 @@ class Problem:
         )  # fmt: skip
 
     def grow(self, max_samples: int) -> None:
-        """Double every output array that is nearly full (samples: double, up to
-        max_samples rows)."""
+        """Double the arrays the loop ran short of: impacts, phases and accumulation
+        times when nearly full (the loop checks them before every step); otherwise the
+        samples (the only rows a step itself asks for), up to max_samples rows.  Growing
+        the large sample arrays only when they are what is short keeps runs with many
+        chatter completions from copying them again and again."""
         c = self.counts
-        for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES)):
+        short = False
+        for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES),
+                          ("accumulations", N_ACCUMULATIONS)):  # fmt: skip
             arr = getattr(self, name)
             if len(arr) - c[col] < 8:
                 setattr(self, name, _grown(arr, 2 * len(arr)))
-        if len(self.accumulations) - c[N_ACCUMULATIONS] < 8:
-            self.accumulations = _grown(self.accumulations, 2 * len(self.accumulations))
+                short = True
         rows = min(2 * len(self.sample_t), max(max_samples, 1))
-        if rows > len(self.sample_t):
+        if not short and rows > len(self.sample_t):
             self.sample_t = _grown(self.sample_t, rows)
             self.sample_y = _grown(self.sample_y, rows)
             self.sample_e = _grown(self.sample_e, rows)

@@ -146,15 +146,20 @@ class Trajectory:
     def n_samples(self) -> int:
         return len(self.t)
 
-    def impact_times(self) -> np.ndarray:
+    def impact_column(self, name: str) -> np.ndarray:
+        """One field of every impact (ImpactLog.COLUMNS: t, t_lo, contact, impulse,
+        v_normal_pre, v_normal_post) as an array, read from the log's rows when the
+        impacts are an ImpactLog (no ImpactEvent objects made)."""
         if isinstance(self.impacts, ImpactLog):
-            return self.impacts.column("t")
-        return np.array([e.t for e in self.impacts])
+            return self.impacts.column(name)
+        dtype = int if name == "contact" else float
+        return np.array([getattr(e, name) for e in self.impacts], dtype=dtype)
+
+    def impact_times(self) -> np.ndarray:
+        return self.impact_column("t")
 
     def impact_contacts(self) -> np.ndarray:
-        if isinstance(self.impacts, ImpactLog):
-            return self.impacts.column("contact")
-        return np.array([e.contact for e in self.impacts], dtype=int)
+        return self.impact_column("contact")
 
     def final_state(self) -> dict[str, list[float]]:
         return {

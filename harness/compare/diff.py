@@ -38,14 +38,7 @@ FIELDS = ("t", "contact", "impulse", "v_normal_pre", "v_normal_post")
 def impact_columns(traj: Trajectory) -> dict[str, np.ndarray]:
     """The impacts of a run as columns: t (s), contact, impulse (N·s), v_normal_pre and
     v_normal_post (m/s, normal velocity of the contact point before and after)."""
-    imps = list(traj.impacts)
-    return {
-        "t": np.array([e.t for e in imps], dtype=float),
-        "contact": np.array([e.contact for e in imps], dtype=np.int64),
-        "impulse": np.array([e.impulse for e in imps], dtype=float),
-        "v_normal_pre": np.array([e.v_normal_pre for e in imps], dtype=float),
-        "v_normal_post": np.array([e.v_normal_post for e in imps], dtype=float),
-    }
+    return {name: traj.impact_column(name) for name in FIELDS}
 
 
 def _statuses(run: EngineRun, n_ref: int) -> tuple[list[str], np.ndarray, str | None]:

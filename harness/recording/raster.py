@@ -70,9 +70,10 @@ def log_raster(rec: rr.RecordingStream, runs: list[RunView], n_contacts: int, t_
         )
         imps = run.trajectory.impacts
         if imps:
-            t = np.array([e.t for e in imps])
-            y = base + np.array([e.contact for e in imps], dtype=float)
-            sizes = marker_sizes(np.array([e.impulse for e in imps]), biggest)
+            traj = run.trajectory
+            t = traj.impact_times()
+            y = base + traj.impact_contacts().astype(float)
+            sizes = marker_sizes(traj.impact_column("impulse"), biggest)
             rec.send_columns(
                 path,
                 [time_column(t)],

@@ -200,8 +200,7 @@ def _log_impact_marker(
     )
     if not traj.impacts:
         return
-    t = np.array([e.t for e in traj.impacts])
-    contact = np.array([e.contact for e in traj.impacts], dtype=int)
+    t, contact = traj.impact_times(), traj.impact_contacts()
     sample = np.clip(np.searchsorted(traj.t, t), 0, traj.n_samples - 1)
     where = drawn[sample, np.clip(contact, 0, drawn.shape[1] - 1)]
     rec.send_columns(f"{root}/impact", [time_column(t)], rr.Points3D.columns(positions=where))

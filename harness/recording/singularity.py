@@ -86,12 +86,11 @@ def impact_points(run: RunView, end: EndTime) -> tuple[np.ndarray, np.ndarray, n
     traj = run.trajectory
     if run.fit.t_f is not None and len(run.fit.time_to_go):
         ttg, E = run.fit.time_to_go, run.fit.energy
-        t = np.array([e.t for e in traj.impacts[: len(ttg)]])
+        t = traj.impact_column("t")[: len(ttg)]
     else:
         if not traj.impacts or traj.n_samples == 0:
             return np.zeros(0), np.zeros(0), np.zeros(0)
-        t = np.array([e.t for e in traj.impacts])
-        lo = np.array([e.t_lo for e in traj.impacts])
+        t, lo = traj.impact_column("t"), traj.impact_column("t_lo")
         ttg = _ttg(t, lo, end)
         idx = pre_impact_samples(traj)
         E = np.where(idx >= 0, run.excess[np.maximum(idx, 0)], np.nan)

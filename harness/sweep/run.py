@@ -3,6 +3,8 @@ of E ≈ a (t_f − t)^c (paper eq. scalinglaw, section 4.3).
 
 - `linear`: reference.linear.simulate.run_linear_exponent, which runs the linearised
   model to the singularity and fits c with its own estimator.
+- `reference`: the exact reference called directly, samples at its events only
+  (`run_reference_sample`), then as below.
 - every other simulator: a Scene (the n-gon, a = m = 1, on flat ground, from (q0, p0) via
   reference.scene.initial_from_linear), harness.simulators.run_simulator, and
   reference.exponent.trajectory_exponent on the energy above the resting level: the
@@ -80,8 +82,8 @@ def fixed_step_t_end(config: SweepConfig, rho: float, gamma: float, q0, p0) -> f
 
 
 def run_trajectory_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) -> dict:
-    from reference.exponent import excess_energy_of, trajectory_exponent
-
+    """A simulator other than the linear model, through harness.simulators.run_simulator
+    (its checks and guard), then `exponent_result`."""
     from ..simulators import is_fixed_step, run_simulator
 
     t_end = config.t_end
@@ -89,6 +91,28 @@ def run_trajectory_sample(config: SweepConfig, rho: float, gamma: float, q0, p0)
         t_end = min(t_end, fixed_step_t_end(config, rho, gamma, q0, p0))
     scene = polygon_scene(config, rho, gamma, q0, p0)
     traj = run_simulator(config.engine, scene, dt=config.dt, t_end=t_end)
+    return exponent_result(traj, scene, config)
+
+
+def run_reference_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) -> dict:
+    """The exact reference, called directly with samples at its events only (no regular
+    grid): the fit reads the energy before each impact, which the sample after the
+    previous event holds (energy is constant in flight and in frictionless contact
+    phases).  The reference ends a nonfinite or penetrating state with an explicit
+    status itself, so the engines' guard is not needed; the scene is checked as any."""
+    from reference import ReferenceOptions, simulate
+
+    scene = polygon_scene(config, rho, gamma, q0, p0).with_run(t_end=config.t_end)
+    traj = simulate(scene, options=ReferenceOptions(sample_dt=config.t_end))
+    return exponent_result(traj, scene, config)
+
+
+def exponent_result(traj, scene, config: SweepConfig) -> dict:
+    """The row's results of one run: its status, t_singularity and impacts, and c
+    (`reference.exponent.trajectory_exponent` on the energy above the resting level) for
+    runs that reached the singularity."""
+    from reference.exponent import excess_energy_of, trajectory_exponent
+
     status = traj.status.value
     out = {
         "status": status,
@@ -125,7 +149,8 @@ def warm_up(config: SweepConfig) -> None:
 
 def sample_runner(engine: str):
     """The function (config, rho, gamma, q0, p0) -> result dict for an engine."""
-    return run_linear_sample if engine == "linear" else run_trajectory_sample
+    runners = {"linear": run_linear_sample, "reference": run_reference_sample}
+    return runners.get(engine, run_trajectory_sample)
 
 
 def run_chunk(chunk: Chunk) -> list[dict]:
