@@ -73,7 +73,7 @@ def test_integration_is_scipys_dop853_step_for_step(two):
     )  # fmt: skip
     ours = new_work()
     r = integrate_held(
-        y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], np.zeros(0), 0, out,
+        y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], (0, 1.0, 0), out,
         (0.0, 0.0), 0, False, np.zeros(0, dtype=np.int64), 0,
     )  # fmt: skip
     assert r.status == INT_DONE
@@ -114,7 +114,7 @@ def test_crossing_is_located_where_scipys_event_finds_it():
     )  # fmt: skip
     watch = np.arange(1, 5, dtype=np.int64)
     r = integrate_held(
-        y, 2.0, model, pts, idx, m, rtol, atol, scratch[0], scratch[0], np.zeros(0), 0, out,
+        y, 2.0, model, pts, idx, m, rtol, atol, scratch[0], scratch[0], (0, 1.0, 0), out,
         (0.0, 0.0), 0, False, watch, 4,
     )  # fmt: skip
     assert r.status == INT_CROSSING

@@ -13,10 +13,9 @@ with n."""
 import math
 from collections import namedtuple
 
-from numba import njit
-
 from .contacts import contact_jet, rim_jet, vertex_gap_noise
 from .horizon import horizon_bound, local_time_cap, safe_horizon
+from .jit import hot
 from .roots import quadratic_taylor_root
 from .tolerances import WINDOW_GROW, WINDOW_MAX, WINDOW_ROUNDS
 from .window import use_window, vertex_window, window_offsets
@@ -26,7 +25,7 @@ from .window import use_window, vertex_window, window_offsets
 Examined = namedtuple("Examined", ["n", "K", "k0", "lo", "hi", "windowed"])
 
 
-@njit(cache=True)
+@hot
 def is_held(state, k):
     """Whether contact k is held."""
     for i in range(state.n_active):
@@ -35,7 +34,7 @@ def is_held(state, k):
     return False
 
 
-@njit(cache=True)
+@hot
 def _list_free(state, cs, first, count, n, m):
     """Append to cs.cand[m:] the free contacts among first, first + 1, … (count of them,
     mod n); returns the new length."""
@@ -47,7 +46,7 @@ def _list_free(state, cs, first, count, n, m):
     return m
 
 
-@njit(cache=True)
+@hot
 def _jets(y, model, pts, acc, cs, i0, i1):
     """Jets of cs.cand[i0:i1] with the held acceleration acc."""
     for i in range(i0, i1):
@@ -55,7 +54,7 @@ def _jets(y, model, pts, acc, cs, i0, i1):
         cs.gap[i], cs.rate[i], cs.accel[i], cs.noise[i] = j.gap, j.rate, j.accel, j.noise
 
 
-@njit(cache=True)
+@hot
 def touching_candidates(state, model, pts, opts, acc, cs, touch):
     """List and jet the contacts to examine first: every free one, or (windowed) the
     vertices whose gap may be within `touch` of the ground and WINDOW_MAX more on each
@@ -78,7 +77,7 @@ def touching_candidates(state, model, pts, opts, acc, cs, touch):
     return Examined(m, K, k0, -half, half, 2 * half + 1 < n)
 
 
-@njit(cache=True)
+@hot
 def _grow(state, model, pts, acc, cs, ex, lo, hi, m, nlo, nhi, h):
     """Examine the vertices of offsets nlo … lo − 1 and hi + 1 … nhi from ex.k0; returns
     (h shortened by their safe steps, the new list length)."""
@@ -92,7 +91,7 @@ def _grow(state, model, pts, acc, cs, ex, lo, hi, m, nlo, nhi, h):
     return safe_horizon(cs, m0, m, ex.K, h), m
 
 
-@njit(cache=True)
+@hot
 def certified_horizon(state, model, pts, acc, cs, ex, h):
     """The chunk no free contact should reach the ground within, at most h: the horizon
     of the examined contacts, and (windowed) grown or shortened until window(h) has
@@ -118,7 +117,7 @@ def certified_horizon(state, model, pts, acc, cs, ex, h):
     return _grow(state, model, pts, acc, cs, ex, lo, hi, m, lo, lo + n - 1, h)
 
 
-@njit(cache=True)
+@hot
 def set_aside_approaching(cs, ex, vnoise, gap_res):
     """Move the examined contacts approaching the ground (rate < −vnoise) within the gap
     resolution but above its roundoff (noise < gap ≤ gap_res) from cs.cand to cs.near:

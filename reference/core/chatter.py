@@ -11,14 +11,13 @@ by O((u/V)²) relative: chatter_tol² = 1e-12 for the default chatter_tol = 1e-6
 
 import math
 
-from numba import njit
-
 from .contacts import contact_frame, velocity_scale
 from .impact import bounce_ratio
+from .jit import hot
 from .tolerances import CHATTER_BOUNCE_FLOOR, TINY
 
 
-@njit(cache=True)
+@hot
 def completion_speed(y, model, pts, k, chatter_tol, vnoise):
     """u below which a separation of contact k (just hit) is completed: chatter_tol × V,
     and at least CHATTER_BOUNCE_FLOOR √(2 |a| noise) (a bounce lower than 1e4 roundoff
@@ -32,7 +31,7 @@ def completion_speed(y, model, pts, k, chatter_tol, vnoise):
     return max(small, CHATTER_BOUNCE_FLOOR * math.sqrt(2.0 * a_scale * noise), vnoise)
 
 
-@njit(cache=True)
+@hot
 def accumulation_time(t, u, a_n, gamma):
     """When the bounces of speed u under normal acceleration a_n < 0 accumulate:
     t + 2u / (|a_n| (1 − r)) with r = bounce_ratio(γ) (a bouncing ball: the flight

@@ -14,12 +14,12 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
 
 from . import dop853_tableau as tab
-from .clock import two_sum_add
+from .clock import grid_time, two_sum_add
 from .contacts import contact_frame
 from .held import held_forces, held_rhs
+from .jit import copy_into, hot
 from .output import push_sample
 from .tolerances import EPS, LOCATE_ITERATIONS, LOCATE_XTOL
 
@@ -47,12 +47,12 @@ Integration = namedtuple("Integration", ["status", "s", "nfev", "leaving"])
 # accepted (lam_new).  The held functions use the same record as their `work`.
 
 
-@njit(cache=True)
+@hot
 def dop853_step(y, f0, h, model, pts, idx, m, work, K, y_new, tmp):
     """One DOP853 step of size h from (y, f0 = f(y)) into y_new; K receives the stages
     and f(y_new) as its last row (work.lam: the held forces at y_new).  Returns the
     number of right-hand-side evaluations."""
-    K[0, :] = f0
+    copy_into(K[0], f0)
     for s in range(1, N_STAGES):
         for c in range(13):
             acc = 0.0
@@ -69,7 +69,7 @@ def dop853_step(y, f0, h, model, pts, idx, m, work, K, y_new, tmp):
     return N_STAGES
 
 
-@njit(cache=True)
+@hot
 def _rms(v, scale):
     s = 0.0
     for i in range(v.shape[0]):
@@ -77,7 +77,7 @@ def _rms(v, scale):
     return math.sqrt(s / v.shape[0])
 
 
-@njit(cache=True)
+@hot
 def error_norm(K, h, scale):
     """scipy's DOP853 error norm (rk.DOP853._estimate_error_norm)."""
     e5 = 0.0
@@ -95,7 +95,7 @@ def error_norm(K, h, scale):
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 13)
 
 
-@njit(cache=True)
+@hot
 def initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st):
     """scipy.integrate._ivp.common.select_initial_step for order 7.  Returns (h, nfev)."""
     for c in range(13):
@@ -118,7 +118,7 @@ def initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st):
     return min(100 * h0, h1, s_end), 1
 
 
-@njit(cache=True)
+@hot
 def dense_output(y, y_new, h, model, pts, idx, m, work, st):
     """scipy's DOP853 dense output of the step y → y_new of size h (stages in st.K, f(y)
     its first row and f(y_new) its last): three more stages into st.K[13:16] and the
@@ -149,7 +149,7 @@ def dense_output(y, y_new, h, model, pts, idx, m, work, st):
     return N_STAGES_EXTRA
 
 
-@njit(cache=True)
+@hot
 def dense_state(y, F, x, out):
     """The interpolated state at the fraction x ∈ [0, 1] of the step from y
     (Dop853DenseOutput._call_impl)."""
@@ -162,7 +162,7 @@ def dense_state(y, F, x, out):
         out[c] = v + y[c]
 
 
-@njit(cache=True)
+@hot
 def _lowest_gap(y, model, pts, watch, n_watch):
     """The smallest gap among contacts watch[:n_watch] at y."""
     g = math.inf
@@ -171,7 +171,7 @@ def _lowest_gap(y, model, pts, watch, n_watch):
     return g
 
 
-@njit(cache=True)
+@hot
 def _watched_at(y, sigma, h, model, pts, idx, m, work, st, leaving, watch, n_watch):
     """At local time σ of the step (its dense output, state into st.ys): held force
     `leaving` if ≥ 0, else the lowest gap of watch[:n_watch]."""
@@ -182,7 +182,7 @@ def _watched_at(y, sigma, h, model, pts, idx, m, work, st, leaving, watch, n_wat
     return _lowest_gap(st.ys, model, pts, watch, n_watch)
 
 
-@njit(cache=True)
+@hot
 def locate_in_step(y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n_watch, xtol):
     """σ in (0, h] where the watched value (held force `leaving`, or the lowest watched
     gap: v0 > 0 at the step's start, vh ≤ 0 at its end) reaches zero, on the step's
@@ -213,27 +213,30 @@ def locate_in_step(y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n
     return hi, it + 2 if leaving >= 0 else 0
 
 
-@njit(cache=True)
-def _grid_samples(
-    y, f, t, t_stop, grid, gi, n_grid, model, pts, idx, m, work, st, out, clock, max_samples
-):
+@hot
+def _grid_samples(y, f, t, t_stop, grid, gi, model, pts, idx, m, work, st, out, clock, max_samples):
     """Samples at the grid times in (t, t_stop] (local times), each by one DOP853 step
-    from (y, f) at t, stamped clock = (t_hi, t_lo) + the grid time; returns (next grid
-    index, nfev)."""
+    from (y, f) at t, stamped clock = (t_hi, t_lo) + the grid time; grid = (k, dt, n):
+    the local times of the grid points (k + i)·dt, i < n (`clock.grid_time`).  Returns
+    (next grid index, nfev)."""
     nfev = 0
-    while gi < n_grid and grid[gi] <= t_stop:
-        hs = grid[gi] - t
+    k, dt, n_grid = grid
+    while gi < n_grid:
+        s = grid_time(k + gi, dt, clock[0], clock[1])
+        if s > t_stop:
+            break
+        hs = s - t
         if hs > 0.0:
             nfev += dop853_step(y, f, hs, model, pts, idx, m, work, st.Ks, st.ys, st.tmp)
         else:
-            st.ys[:] = y
-        hi, lo = two_sum_add(clock[0], clock[1], grid[gi])
+            copy_into(st.ys, y)
+        hi, lo = two_sum_add(clock[0], clock[1], s)
         push_sample(out, hi, lo, st.ys, model, max_samples)
         gi += 1
     return gi, nfev
 
 
-@njit(cache=True)
+@hot
 def _most_negative(lam, m):
     """Index of the most negative held force, −1 if none is negative."""
     i_min, v_min = -1, 0.0
@@ -243,7 +246,7 @@ def _most_negative(lam, m):
     return i_min
 
 
-@njit(cache=True)
+@hot
 def _accepted_step(y, f, t, s_end, h_abs, rtol, atol, model, pts, idx, m, work, st):
     """One accepted DOP853 step from local time t into st.y_new, with scipy's step-size
     control: a rejected step shrinks by max(MIN_FACTOR, SAFETY err^(−1/8)), an accepted
@@ -274,7 +277,7 @@ def _accepted_step(y, f, t, s_end, h_abs, rtol, atol, model, pts, idx, m, work, 
         rejected = True
 
 
-@njit(cache=True)
+@hot
 def integrate_held(
     y,
     s_end,
@@ -287,7 +290,6 @@ def integrate_held(
     work,
     st,
     grid,
-    n_grid,
     out,
     clock,
     max_samples,
@@ -296,8 +298,9 @@ def integrate_held(
     n_watch,
 ):
     """Integrate the held motion from y (in place) over [0, s_end] with scipy's adaptive
-    DOP853; grid samples at the local times grid[:n_grid] (ascending, inside (0, s_end)),
-    stamped with clock = (t_hi, t_lo) + the local time.  With watch_forces, stop where a
+    DOP853; grid samples at the grid's local times (grid = (k, dt, n): (k + i)·dt from
+    the clock, i < n, ascending, inside (0, s_end)), stamped with clock = (t_hi, t_lo) +
+    the local time.  With watch_forces, stop where a
     held force reaches zero (INT_LIFT_OFF, y = the state there); with n_watch > 0, where
     the lowest gap of contacts watch[:n_watch] reaches zero (INT_CROSSING)."""
     f = st.f
@@ -337,19 +340,19 @@ def integrate_held(
                 y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n_watch,
                 LOCATE_XTOL * s_end,
             )  # fmt: skip
-            y_new[:] = st.ys
+            copy_into(y_new, st.ys)
             gi, nf2 = _grid_samples(
-                y, f, t, t + sigma, grid, gi, n_grid, model, pts, idx, m, work, st, out,
+                y, f, t, t + sigma, grid, gi, model, pts, idx, m, work, st, out,
                 clock, max_samples,
             )  # fmt: skip
-            y[:] = y_new
+            copy_into(y, y_new)
             return Integration(status, t + sigma, nfev + nf + nf2, leaving)
         gi, nf = _grid_samples(
-            y, f, t, t_new, grid, gi, n_grid, model, pts, idx, m, work, st, out, clock, max_samples
+            y, f, t, t_new, grid, gi, model, pts, idx, m, work, st, out, clock, max_samples
         )
         nfev += nf
-        y[:] = y_new
-        f[:] = K[N_STAGES]
+        copy_into(y, y_new)
+        copy_into(f, K[N_STAGES])
         for i in range(m):
             st.lam_cur[i] = st.lam_new[i]
         t = t_new

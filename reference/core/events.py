@@ -3,13 +3,12 @@ contacts it leaves held), an activation (contacts landing at rest start to be he
 and the start of the run.  Each returns False when it ended the run (state.status
 set), True otherwise."""
 
-from numba import njit
-
 from .chatter import accumulation_time, completion_speed
 from .contacts import contact_frame, contact_jet, normal_velocity, rate_noise, velocity_scale
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
+from .jit import copy_into, hot
 from .output import push_accumulation, push_impact, push_sample
 from .records import (
     STATUS_AT_REST,
@@ -19,7 +18,7 @@ from .records import (
 )
 
 
-@njit(cache=True)
+@hot
 def end_run(state, status, contacts, n):
     """Stop with `status` at the current time, naming contacts[:n]."""
     state.status = status
@@ -29,7 +28,7 @@ def end_run(state, status, contacts, n):
         state.info[i] = contacts[i]
 
 
-@njit(cache=True)
+@hot
 def hold(state, model, pts, ws, cand, m):
     """Zero the normal velocities of cand[:m] and hold the contacts the LCP keeps.  More
     than three candidates are the body lying down: all of them are held (the loop then
@@ -55,7 +54,7 @@ def hold(state, model, pts, ws, cand, m):
     return True
 
 
-@njit(cache=True)
+@hot
 def _completes(state, model, pts, ws, k, m, u, vnoise):
     """Whether contact k, separating at u ≤ the completion speed with cand[:m] held,
     falls back (a_n < 0) or is at rest: then its chatter is completed."""
@@ -64,7 +63,7 @@ def _completes(state, model, pts, ws, k, m, u, vnoise):
     return a_n < 0 or u <= vnoise, a_n
 
 
-@njit(cache=True)
+@hot
 def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, resting, n_rest):
     """The impact of hitting[0] with resting[:n_rest] held (paper §2.3), then the
     contacts to hold: resting ones left at rest or separating slower than the completion
@@ -78,11 +77,11 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
         stats.max_penetration, -contact_frame(y, model.flat_ground, pts, k).gap
     )
     vnoise = rate_noise(y, model.radius)
-    ws.y_start[:] = y
+    copy_into(ws.y_start, y)
     out_imp = impact(y, model, pts, k)
     n_pushed = pushed_contacts(y, model, pts, resting, n_rest, vnoise, ws.before)
     if n_pushed > 0:
-        y[:] = ws.y_start
+        copy_into(y, ws.y_start)
         state.info_contact = k
         end_run(state, STATUS_PUSHED, ws.before, n_pushed)
         return False
@@ -117,7 +116,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
     return True
 
 
-@njit(cache=True)
+@hot
 def activate(state, model, pts, ws, stats, landing, n_land):
     """Contacts landing at rest (touching, no approach speed, accelerating into the
     ground) start to be held with the held ones: zero their normal velocities (roundoff
@@ -150,7 +149,7 @@ def activate(state, model, pts, ws, stats, landing, n_land):
     return True
 
 
-@njit(cache=True)
+@hot
 def np_sort_prefix(a, m):
     """Sort a[:m] in place (m ≤ 4)."""
     for i in range(1, m):
@@ -160,7 +159,7 @@ def np_sort_prefix(a, m):
             j -= 1
 
 
-@njit(cache=True)
+@hot
 def _same_set(a, na, b, nb):
     if na != nb:
         return False
@@ -174,7 +173,7 @@ def _same_set(a, na, b, nb):
     return True
 
 
-@njit(cache=True)
+@hot
 def start(state, model, pts, opts, stats, out, ws, cs):
     """The run's first step: sample the initial state, then resolve contacts touching at
     t = 0 (hitting: an impact with the resting ones held; resting only: hold them).

@@ -12,10 +12,10 @@ drift.  Impulses act along the normals: on flat ground horizontal momentum and t
 vertical angular momentum are untouched."""
 
 import numpy as np
-from numba import njit
 
 from .contacts import contact_frame, normal_acceleration, normal_velocity
 from .inertia import apply_impulse, free_acceleration, impulse_response
+from .jit import hot
 from .linalg import solve_small
 from .records import SCRATCH, Response
 from .rotation import quaternion_rate, rotate_attitude
@@ -30,7 +30,7 @@ def new_work():
     return np.zeros(1, dtype=SCRATCH)
 
 
-@njit(cache=True)
+@hot
 def _row_dot(geo, i, resp, j):
     """J_i M⁻¹ J_jᵀ from contact i's normal and lever (geo row) and contact j's response."""
     nx, ny, nz, rx, ry, rz = geo[i, 0], geo[i, 1], geo[i, 2], geo[i, 3], geo[i, 4], geo[i, 5]
@@ -45,13 +45,13 @@ def _row_dot(geo, i, resp, j):
     )
 
 
-@njit(cache=True)
+@hot
 def _response(work, i):
     r = work.resp
     return Response(r[i, 0], r[i, 1], r[i, 2], r[i, 3], r[i, 4], r[i, 5], r[i, 6])
 
 
-@njit(cache=True)
+@hot
 def contact_system(y, model, pts, idx, m, acc, work):
     """work.A = J M⁻¹ Jᵀ, work.b = J acc + bias (normal accelerations without contact
     forces when acc is the free acceleration), work.resp rows = M⁻¹J_iᵀ and w_i, for
@@ -70,7 +70,7 @@ def contact_system(y, model, pts, idx, m, acc, work):
             work.A[i, j] = work.resp[i, 6] if i == j else _row_dot(work.geo, i, work.resp, j)
 
 
-@njit(cache=True)
+@hot
 def held_forces(y, model, pts, idx, m, work):
     """Normal forces λ (into work.lam) that keep contacts idx[:m] at zero normal
     acceleration: A λ = −b.  Returns the free acceleration and whether A was regular."""
@@ -81,7 +81,7 @@ def held_forces(y, model, pts, idx, m, work):
     return acc, solve_small(work.A, work.r, m, work.lam)
 
 
-@njit(cache=True)
+@hot
 def held_acceleration(y, model, pts, idx, m, work):
     """(v̇, ω̇) with contacts idx[:m] held (forces may be negative: that is the lift-off
     signal); the free acceleration when m = 0."""
@@ -98,7 +98,7 @@ def held_acceleration(y, model, pts, idx, m, work):
     return ax, ay, az, bx, by, bz
 
 
-@njit(cache=True)
+@hot
 def held_rhs(y, model, pts, idx, m, work, dy):
     """dy/dt of the held motion into dy (forces in work.lam)."""
     acc = held_acceleration(y, model, pts, idx, m, work)
@@ -108,7 +108,7 @@ def held_rhs(y, model, pts, idx, m, work, dy):
         dy[7 + c] = acc[c]
 
 
-@njit(cache=True)
+@hot
 def zero_normal_velocities(y, model, pts, idx, m, work):
     """In place: normal impulses at contacts idx[:m] that set their normal velocities to
     zero, Δ(v, ω) = M⁻¹Jᵀ A⁻¹ (0 − u).  Returns False if A is singular."""
@@ -126,7 +126,7 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
     return True
 
 
-@njit(cache=True)
+@hot
 def project_held(y, model, pts, idx, m, work):
     """In place: project y onto the constraints of contacts idx[:m]: PROJECTION_PASSES
     Gauss–Newton passes moving the body by M⁻¹Jᵀ A⁻¹ (−gap) (a translation and a small
@@ -154,23 +154,23 @@ def project_held(y, model, pts, idx, m, work):
     return zero_normal_velocities(y, model, pts, idx, m, work)
 
 
-@njit(cache=True)
+@hot
 def _lcp_admissible(work, m, mask, tol):
     """Whether the active set `mask` (bits over the m candidates) solves the LCP: its
     forces (into work.lam) are ≥ −tol(1 + |λ|) and every other candidate's normal
     acceleration is ≥ 0."""
-    sel = np.empty(3, dtype=np.int64)
+    sel, As, sol = work.sel, work.As, work.sol
     s = 0
     for i in range(m):
         if mask & (1 << i):
             sel[s] = i
             s += 1
-    As = np.empty((3, 3))
     for a in range(s):
         work.r[a] = -work.b[sel[a]]
         for c in range(s):
             As[a, c] = work.A[sel[a], sel[c]]
-    sol = np.zeros(3)
+    for a in range(3):
+        sol[a] = 0.0
     if not solve_small(As, work.r, s, sol):
         return False
     for a in range(s):
@@ -191,7 +191,7 @@ def _lcp_admissible(work, m, mask, tol):
     return True
 
 
-@njit(cache=True)
+@hot
 def solve_lcp(y, model, pts, cand, m, work, active, tol=0.0):
     """Contacts to hold among the candidates cand[:m] (at zero gap and normal velocity):
     the acceleration-level LCP, by enumeration from the largest active set down (sets of
@@ -214,7 +214,7 @@ def solve_lcp(y, model, pts, cand, m, work, active, tol=0.0):
     return -1
 
 
-@njit(cache=True)
+@hot
 def _popcount(mask):
     c = 0
     while mask:

@@ -4,9 +4,8 @@ overshot by much (the lift-off is then located inside the chunk)."""
 
 import math
 
-from numba import njit
-
 from .contacts import length_scale, velocity_scale
+from .jit import hot
 from .roots import safe_step
 from .tolerances import (
     FORCE_TREND_FACTOR,
@@ -17,14 +16,14 @@ from .tolerances import (
 )
 
 
-@njit(cache=True)
+@hot
 def horizon_bound(acc_scale, gravity):
     """K = HORIZON_ACC_FACTOR × (a scale of |g″|) + g: the curvature the chunk horizon
     allows a free gap (a margin on its current second derivative, not a bound)."""
     return HORIZON_ACC_FACTOR * acc_scale + gravity + TINY
 
 
-@njit(cache=True)
+@hot
 def local_time_cap(y, model, K):
     """LOCAL_TIME_FRACTION of min(√(L/K), ROTATION_TIME_FACTOR a/V): a chunk stays short
     against the time the body takes to fall its own size and the rim its radius."""
@@ -35,7 +34,7 @@ def local_time_cap(y, model, K):
     return LOCAL_TIME_FRACTION * t_local
 
 
-@njit(cache=True)
+@hot
 def safe_horizon(cs, i0, i1, K, h):
     """h shortened to the first root of max(P2, T2) of each examined free gap
     cs.cand[i0:i1] (jets in cs): P2 its quadratic lower bound with curvature K, T2 its
@@ -49,7 +48,7 @@ def safe_horizon(cs, i0, i1, K, h):
     return h
 
 
-@njit(cache=True)
+@hot
 def force_trend_limit(h, lam, lam_prev, h_prev, m):
     """h shortened so that a held force falling at its rate over the previous chunk
     reaches zero only after FORCE_TREND_FACTOR × its current value / rate."""

@@ -9,21 +9,20 @@ undecidable in this model.  Changing the impact law is an edit of
 `post_impact_velocity` alone: the chatter series and the capture of a γ = 0 contact
 (reference.core.chatter, events) use the ratio it gives (`bounce_ratio`)."""
 
-from numba import njit
-
 from .contacts import contact_frame, normal_velocity
 from .inertia import apply_impulse, impulse_response
+from .jit import hot
 from .records import ImpactOutcome
 
 
-@njit(cache=True)
+@hot
 def post_impact_velocity(u_pre, gamma):
     """Newton's impact law (paper eq. utk3): the contact's normal velocity after the
     impact is −γ times the one before."""
     return -gamma * u_pre
 
 
-@njit(cache=True)
+@hot
 def bounce_ratio(gamma):
     """u⁺/|u⁻| of the impact law: the factor by which a contact's rebound speed shrinks
     from one bounce to the next (γ for Newton's law).  The chatter series (a geometric
@@ -31,7 +30,7 @@ def bounce_ratio(gamma):
     return post_impact_velocity(-1.0, gamma)
 
 
-@njit(cache=True)
+@hot
 def impact(y, model, pts, k):
     """In place: the impact of contact k on state y (positions unchanged)."""
     flat = model.flat_ground
@@ -43,7 +42,7 @@ def impact(y, model, pts, k):
     return ImpactOutcome(zeta, u_pre, normal_velocity(y, f, flat))
 
 
-@njit(cache=True)
+@hot
 def pushed_contacts(y, model, pts, held, n_held, vnoise, out):
     """The paper's rule beside held contacts: the held contacts that the impact just
     applied to y leaves approaching the ground (normal velocity < −vnoise) go to `out`;

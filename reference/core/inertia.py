@@ -2,20 +2,19 @@
 frame): inverse inertia in the world frame, the response of (v, ω) to a normal impulse,
 the torque-free angular acceleration, and energies (paper §2.2–2.3)."""
 
-from numba import njit
-
+from .jit import hot
 from .records import Response
 from .rotation import body_axis
 
 
-@njit(cache=True)
+@hot
 def inverse_inertia(e3x, e3y, e3z, i1, i3, cx, cy, cz):
     """I⁻¹ c in the world frame: c/i1 + (1/i3 − 1/i1)(e3·c) e3."""
     f = (1.0 / i3 - 1.0 / i1) * (e3x * cx + e3y * cy + e3z * cz)
     return cx / i1 + f * e3x, cy / i1 + f * e3y, cz / i1 + f * e3z
 
 
-@njit(cache=True)
+@hot
 def impulse_response(y, f, mass, i1, i3):
     """M⁻¹Jᵀ and w = J M⁻¹ Jᵀ for the contact with frame f, J = [nᵀ, (r × n)ᵀ]: a normal
     impulse ζ changes v by ζ n/m, ω by ζ I⁻¹(r × n), the normal velocity by ζ w
@@ -29,7 +28,7 @@ def impulse_response(y, f, mass, i1, i3):
     return Response(f.nx / mass, f.ny / mass, f.nz / mass, ix, iy, iz, w)
 
 
-@njit(cache=True)
+@hot
 def response_rate(f, resp):
     """J_f M⁻¹ J_gᵀ: the change of contact f's normal velocity per unit impulse at the
     contact of `resp` (an entry of the contact system's matrix A)."""
@@ -46,7 +45,7 @@ def response_rate(f, resp):
     )
 
 
-@njit(cache=True)
+@hot
 def apply_impulse(y, resp, zeta):
     """In place: (v, ω) += ζ M⁻¹Jᵀ."""
     y[7] += resp.dvx * zeta
@@ -57,7 +56,7 @@ def apply_impulse(y, resp, zeta):
     y[12] += resp.dwz * zeta
 
 
-@njit(cache=True)
+@hot
 def free_angular_acceleration(y, i1, i3):
     """ω̇ without contact forces, −I⁻¹(ω × Iω) (paper eq. acc2free)."""
     e3x, e3y, e3z = body_axis(y)
@@ -71,14 +70,14 @@ def free_angular_acceleration(y, i1, i3):
     return -ix, -iy, -iz
 
 
-@njit(cache=True)
+@hot
 def free_acceleration(y, i1, i3, gravity):
     """(v̇, ω̇) of the free body: (0, 0, −g) and −I⁻¹(ω × Iω)."""
     ax, ay, az = free_angular_acceleration(y, i1, i3)
     return 0.0, 0.0, -gravity, ax, ay, az
 
 
-@njit(cache=True)
+@hot
 def kinetic_energy(y, mass, i1, i3):
     """½ m|v|² + ½ (I1 |ω⊥|² + I3 ω3²)."""
     e3x, e3y, e3z = body_axis(y)
@@ -89,13 +88,13 @@ def kinetic_energy(y, mass, i1, i3):
     )
 
 
-@njit(cache=True)
+@hot
 def potential_energy(y, mass, gravity):
     """m g z."""
     return mass * gravity * y[2]
 
 
-@njit(cache=True)
+@hot
 def excess_energy(y, flat, mass, i1, i3, gravity):
     """Energy above the lowest level the invariants allow (the body flat on the ground):
     flat: E − ½ m |v_h|² − L_z²/(2 I3); three-point: E − ½ I3 ω3²."""

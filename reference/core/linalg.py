@@ -1,12 +1,13 @@
 """Small dense linear systems (at most three contacts at once), without allocation."""
 
-from numba import njit
+from .jit import hot
 
 
-@njit(cache=True)
+@hot
 def solve_small(A, r, m, out):
     """out[:m] = A[:m, :m]⁻¹ r[:m] for m ≤ 3 (Cramer's rule for m ≤ 2, elimination with
-    partial pivoting for 3).  Returns False when the system is singular."""
+    partial pivoting for 3, which overwrites A and r: callers pass systems they rebuild
+    before each solve).  Returns False when the system is singular."""
     if m == 0:
         return True
     if m == 1:
@@ -19,7 +20,7 @@ def solve_small(A, r, m, out):
     return _solve_3(A, r, out)
 
 
-@njit(cache=True)
+@hot
 def _solve_2(A, r, out):
     """Cramer's rule for a 2 × 2 system."""
     det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
@@ -30,12 +31,10 @@ def _solve_2(A, r, out):
     return True
 
 
-@njit(cache=True)
-def _solve_3(A, r, out):
-    """Gaussian elimination with partial pivoting for a 3 × 3 system, then back
-    substitution."""
-    M = A[:3, :3].copy()
-    v = r[:3].copy()
+@hot
+def _solve_3(M, v, out):
+    """Gaussian elimination with partial pivoting for a 3 × 3 system M x = v, in place,
+    then back substitution."""
     for c in range(3):
         p = c
         for i in range(c + 1, 3):

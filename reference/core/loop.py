@@ -23,6 +23,7 @@ from numba import njit
 from .clock import time_until
 from .events import end_run, start
 from .inertia import excess_energy
+from .jit import hot
 from .output import Output
 from .phases import NEEDS_ROWS, begin_contact_phase, contact_step, flight_step
 from .records import (
@@ -47,13 +48,13 @@ from .workspace import new_contact_lists
 STEP_ROWS = 4
 
 
-@njit(cache=True)
+@hot
 def _span(imp, i, j):
     """Time from impact i to impact j (double-double differences)."""
     return (imp[j, 0] - imp[i, 0]) + (imp[j, 1] - imp[i, 1])
 
 
-@njit(cache=True)
+@hot
 def extrapolate_singularity(out, t_hi):
     """t_f from the last impacts, assuming geometric intervals with a period of m
     impacts (m = 1 … MAX_PERIOD: the vertices of a polygon often take turns, so single
@@ -78,7 +79,7 @@ def extrapolate_singularity(out, t_hi):
     return t_hi
 
 
-@njit(cache=True)
+@hot
 def _below_tilt_floor(state, y, out):
     """After impacts, the tilt α ≈ 2 |(x, y)| of the attitude quaternion is below
     TILT_FLOOR: nonzero, or exactly zero with a contact held.  A body exactly flat with
@@ -90,7 +91,7 @@ def _below_tilt_floor(state, y, out):
     return h < 0.5 * TILT_FLOOR and (h > 0.0 or state.n_active > 0)
 
 
-@njit(cache=True)
+@hot
 def _motion_ended(state, model, opts, out):
     """The end checks between phases (max_impacts, all contacts down, energy exhausted,
     tilt below TILT_FLOOR, t_end); sets the status and returns True when one applies."""
@@ -119,7 +120,7 @@ def _motion_ended(state, model, opts, out):
     return False
 
 
-@njit(cache=True)
+@hot
 def _rows_short(out):
     """Whether impacts, phases or accumulation times have fewer than STEP_ROWS free rows."""
     c = out.counts
@@ -130,7 +131,7 @@ def _rows_short(out):
     )
 
 
-@njit(cache=True)
+@hot
 def _finite(y):
     for c in range(13):
         if not math.isfinite(y[c]):
@@ -138,7 +139,7 @@ def _finite(y):
     return True
 
 
-@njit(cache=True)
+@hot
 def loop_step(state, model, pts, opts, stats, out, ws, cs):
     """One step: the run's start, a contact chunk (or the event ending the phase), or a
     flight to its event, after the end checks between phases."""

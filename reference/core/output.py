@@ -5,9 +5,8 @@ flag is only a guard.  Samples beyond `max_samples` are dropped."""
 
 from collections import namedtuple
 
-from numba import njit
-
 from .inertia import kinetic_energy, potential_energy
+from .jit import copy_into, hot
 from .records import N_ACCUMULATIONS, N_IMPACTS, N_PHASES, N_SAMPLES, OVERFLOW
 
 Output = namedtuple(
@@ -24,7 +23,7 @@ Output = namedtuple(
 )
 
 
-@njit(cache=True)
+@hot
 def push_sample(out, t_hi, t_lo, y, model, max_samples):
     """Record state y at time t_hi + t_lo with its energies."""
     n = out.counts[N_SAMPLES]
@@ -35,13 +34,13 @@ def push_sample(out, t_hi, t_lo, y, model, max_samples):
         return
     out.sample_t[n, 0] = t_hi
     out.sample_t[n, 1] = t_lo
-    out.sample_y[n, :] = y
+    copy_into(out.sample_y[n], y)
     out.sample_e[n, 0] = kinetic_energy(y, model.mass, model.i1, model.i3)
     out.sample_e[n, 1] = potential_energy(y, model.mass, model.gravity)
     out.counts[N_SAMPLES] = n + 1
 
 
-@njit(cache=True)
+@hot
 def push_impact(out, t_hi, t_lo, contact, impulse, u_pre, u_post):
     n = out.counts[N_IMPACTS]
     if n >= out.impacts.shape[0]:
@@ -52,7 +51,7 @@ def push_impact(out, t_hi, t_lo, contact, impulse, u_pre, u_post):
     out.counts[N_IMPACTS] = n + 1
 
 
-@njit(cache=True)
+@hot
 def push_phase(out, t_start, t_end, kind, held, n_held):
     n = out.counts[N_PHASES]
     if n >= out.phases.shape[0]:
@@ -65,7 +64,7 @@ def push_phase(out, t_start, t_end, kind, held, n_held):
     out.counts[N_PHASES] = n + 1
 
 
-@njit(cache=True)
+@hot
 def push_accumulation(out, t):
     n = out.counts[N_ACCUMULATIONS]
     if n >= out.accumulations.shape[0]:

@@ -5,16 +5,13 @@ grow the arrays and redo it identically."""
 
 import math
 
-import numpy as np
-from numba import njit
-
 from .candidates import (
     certified_horizon,
     is_held,
     set_aside_approaching,
     touching_candidates,
 )
-from .clock import time_until, two_sum_add
+from .clock import grid_time, time_until, two_sum_add
 from .contacts import contact_frame, length_scale, rate_noise, velocity_scale
 from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, integrate_held
 from .events import activate, end_run, hold, resolve_impact
@@ -22,6 +19,7 @@ from .flight import flight_bounds, flight_constants, free_flight
 from .held import held_acceleration, held_forces, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
+from .jit import copy_into, hot
 from .output import push_phase, push_sample
 from .records import (
     EVENT_ACTIVATION,
@@ -46,7 +44,7 @@ from .window import use_window, vertex_window
 DONE, NEEDS_ROWS = 0, 1
 
 
-@njit(cache=True)
+@hot
 def grid_count(t_hi, t_lo, s_end, dt):
     """Number of sample-grid times k·dt inside (t, t + s_end)."""
     if not s_end > 0.0:
@@ -60,24 +58,21 @@ def grid_count(t_hi, t_lo, s_end, dt):
     return int(math.ceil((s_end - first) / dt)) + 1
 
 
-@njit(cache=True)
-def grid_times(t_hi, t_lo, s_end, dt, out):
-    """The sample-grid times inside (0, s_end) of local time from t (the same rule as
-    `grid_count`, but each tested); returns how many were written."""
+@hot
+def grid_times(t_hi, t_lo, s_end, dt, limit):
+    """The sample-grid points inside (0, s_end) of local time from t (the rule of
+    `grid_count`, each time tested; at most `limit`): (k, dt, n), the points
+    (k + i)·dt, i < n, as `dop853.integrate_held` reads them (`clock.grid_time`)."""
     kk = math.floor(t_hi / dt) + 1
-    n = 0
-    while n < out.shape[0]:
-        s = kk * dt - t_hi - t_lo
-        if s >= s_end:
-            break
-        if s > 0:
-            out[n] = s
-            n += 1
+    while grid_time(kk, dt, t_hi, t_lo) <= 0:
         kk += 1
-    return n
+    n = 0
+    while n < limit and grid_time(kk + n, dt, t_hi, t_lo) < s_end:
+        n += 1
+    return kk, dt, n
 
 
-@njit(cache=True)
+@hot
 def _needed(n_grid, out, opts):
     """Whether n_grid samples (and a few event samples) do not fit in the free rows
     (counting only what max_samples still admits)."""
@@ -86,7 +81,7 @@ def _needed(n_grid, out, opts):
     return need > out.sample_t.shape[0] - n
 
 
-@njit(cache=True)
+@hot
 def flight_step(state, model, pts, opts, stats, out, ws, cs):
     """Free flight from the state to its first event (or to t_end), then the event."""
     y = state.y
@@ -107,7 +102,7 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     stats.search_iterations += ev.iterations
     kk = math.floor(state.t_hi / opts.sample_dt) + 1
     while True:
-        s = kk * opts.sample_dt - state.t_hi - state.t_lo
+        s = grid_time(kk, opts.sample_dt, state.t_hi, state.t_lo)
         if s >= ev.s:
             break
         if s > 0:
@@ -117,7 +112,7 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
         kk += 1
     t0 = state.t_hi
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, ev.s)
-    y[:] = ws.y_event
+    copy_into(y, ws.y_event)
     push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
     if ev.kind == EVENT_NONE:
@@ -131,7 +126,7 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     return DONE
 
 
-@njit(cache=True)
+@hot
 def begin_contact_phase(state, model, opts):
     """Enter a contact phase with the held contacts: its start, energy and gap
     resolution (roundoff, or the integrator's tolerance on the positions:
@@ -146,7 +141,7 @@ def begin_contact_phase(state, model, opts):
     state.has_trend = False
 
 
-@njit(cache=True)
+@hot
 def close_contact_phase(state, model, stats, out):
     """Record the contact phase that ends now and its energy drift."""
     y = state.y
@@ -162,7 +157,7 @@ def close_contact_phase(state, model, stats, out):
     state.in_contact = False
 
 
-@njit(cache=True)
+@hot
 def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res):
     """A free contact touching while approaching (gap within its roundoff: an impact with
     the held ones) or at rest accelerating into the ground (gap within max(noise,
@@ -195,7 +190,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
     return False
 
 
-@njit(cache=True)
+@hot
 def _set_tolerances(y, model, rtol, atol):
     """Absolute tolerances of a chunk: rtol × the length scale for positions (over a for
     the quaternion), rtol × the velocity scale for velocities (over a for ω)."""
@@ -209,7 +204,7 @@ def _set_tolerances(y, model, rtol, atol):
         atol[c] = rtol * scale_x / model.radius
 
 
-@njit(cache=True)
+@hot
 def _crossed(y, state, model, pts, opts, cs, gap_res):
     """Free contacts below the ground beyond their resolution at y: how many (listed in
     cs.together).  For large polygons only the window of vertices below the ground at y
@@ -231,17 +226,16 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
     return m
 
 
-@njit(cache=True)
+@hot
 def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
     """The first time in (0, h] the crossed contacts (cs.together[:n_crossed]) reach the
     ground: the chunk integrated again from its start watching their gaps, the zero
     located inside the step that holds it (dop853.locate_crossing); ws.y_chunk ends
     there, projected.  The horizon's backstop: its Taylor part is not a bound."""
-    ws.y_chunk[:] = ws.y_start
-    grid = np.empty(0)
+    copy_into(ws.y_chunk, ws.y_start)
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
-        ws, ws, grid, 0, out, (state.t_hi, state.t_lo), opts.max_samples, False, cs.together,
+        ws, ws, (0, 1.0, 0), out, (state.t_hi, state.t_lo), opts.max_samples, False, cs.together,
         n_crossed,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
@@ -249,7 +243,7 @@ def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
     return r.s
 
 
-@njit(cache=True)
+@hot
 def contact_step(state, model, pts, opts, stats, out, ws, cs):
     """One step of a contact phase: the event that ends it, or one integrated chunk."""
     y = state.y
@@ -260,11 +254,12 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         return DONE
     ex, n_near, t_near = set_aside_approaching(cs, ex, rate_noise(y, model.radius), gap_res)
     m = state.n_active
-    lam = ws.lam[:m].copy()
+    for i in range(m):  # the held forces now (ws.lam is reused below)
+        ws.lam_chunk[i] = ws.lam[i]
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
     h, _ = certified_horizon(state, model, pts, acc, cs, ex, min(remaining, t_near))
     if state.has_trend:
-        h = force_trend_limit(h, lam, state.lam_prev, state.h_prev, m)
+        h = force_trend_limit(h, ws.lam_chunk, state.lam_prev, state.h_prev, m)
     if h <= 0:
         close_contact_phase(state, model, stats, out)
         if remaining > 0:
@@ -273,15 +268,14 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     n_grid = grid_count(state.t_hi, state.t_lo, h, opts.sample_dt)
     if _needed(n_grid, out, opts):
         return NEEDS_ROWS
-    grid = np.empty(n_grid + 1)
-    n_grid = grid_times(state.t_hi, state.t_lo, h, opts.sample_dt, grid)
+    grid = grid_times(state.t_hi, state.t_lo, h, opts.sample_dt, n_grid + 1)
     _set_tolerances(y, model, opts.contact_rtol, ws.atol)
-    ws.y_start[:] = y
-    ws.y_chunk[:] = y
+    copy_into(ws.y_start, y)
+    copy_into(ws.y_chunk, y)
     ns0 = out.counts[N_SAMPLES]
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
-        ws, grid, n_grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.near, n_near,
+        ws, grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.near, n_near,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     if r.status == INT_FAILED:
@@ -302,7 +296,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         return _cut_chunk(state, ws, r.s)
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
-    y[:] = ws.y_chunk
+    copy_into(y, ws.y_chunk)
     _, ok = held_forces(y, model, pts, state.active, m, ws)
     for i in range(m):
         state.lam_prev[i] = ws.lam[i]
@@ -314,17 +308,17 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     return DONE
 
 
-@njit(cache=True)
+@hot
 def _cut_chunk(state, ws, s):
     """Advance to local time s of the chunk (state ws.y_chunk), where a free contact
     reached the ground."""
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s)
-    state.y[:] = ws.y_chunk
+    copy_into(state.y, ws.y_chunk)
     state.has_trend = False
     return DONE
 
 
-@njit(cache=True)
+@hot
 def _drop_samples_after(out, ns0, state, s_star):
     """Forget the chunk's grid samples at local times ≥ s_star (the chunk was cut)."""
     n = out.counts[N_SAMPLES]
@@ -335,7 +329,7 @@ def _drop_samples_after(out, ns0, state, s_star):
     out.counts[N_SAMPLES] = keep
 
 
-@njit(cache=True)
+@hot
 def _lift_off(state, model, pts, opts, stats, out, ws, r):
     """A held force reached zero at r.s: advance there, close the phase, and hold the
     others that the LCP keeps."""
@@ -344,7 +338,7 @@ def _lift_off(state, model, pts, opts, stats, out, ws, r):
     if r.s > 0.0:
         stats.contact_chunks += 1
         state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, r.s)
-        y[:] = ws.y_chunk
+        copy_into(y, ws.y_chunk)
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
     close_contact_phase(state, model, stats, out)
     m = 0

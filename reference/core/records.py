@@ -133,6 +133,10 @@ SCRATCH = np.dtype(
         ("b", np.float64, (3,)),  # their normal accelerations without contact forces
         ("r", np.float64, (3,)),  # a right-hand side
         ("lam", np.float64, (3,)),  # forces or impulses
+        ("lam_chunk", np.float64, (3,)),  # held forces at a contact chunk's start
+        ("As", np.float64, (3, 3)),  # the LCP's system of one active set
+        ("sol", np.float64, (3,)),  # and its solution
+        ("sel", np.int64, (3,)),  # and its contacts
         ("resp", np.float64, (3, 7)),  # M⁻¹J_iᵀ and w_i per contact
         ("geo", np.float64, (3, 6)),  # normal and lever per contact
         ("K", np.float64, (16, 13)),  # DOP853 stages, f(y_new), dense-output stages

@@ -5,12 +5,12 @@ components directly (reference.quaternion is the same library for arrays)."""
 
 import math
 
-from numba import njit
+from .jit import hot
 
 HALF_SINC_SERIES_BELOW = 1e-4  # the series' next term, θ⁶/645120, is < 1e-30 there
 
 
-@njit(cache=True)
+@hot
 def half_sinc(theta):
     """sin(θ/2)/θ, accurate for θ → 0."""
     if abs(theta) < HALF_SINC_SERIES_BELOW:
@@ -19,7 +19,7 @@ def half_sinc(theta):
     return math.sin(0.5 * theta) / theta
 
 
-@njit(cache=True)
+@hot
 def qmul(a0, a1, a2, a3, b0, b1, b2, b3):
     """Hamilton product a ⊗ b."""
     return (
@@ -30,7 +30,7 @@ def qmul(a0, a1, a2, a3, b0, b1, b2, b3):
     )
 
 
-@njit(cache=True)
+@hot
 def rotation_vector_quaternion(px, py, pz):
     """exp of the rotation vector (px, py, pz): angle |p| about p/|p|."""
     th = math.sqrt(px * px + py * py + pz * pz)
@@ -38,7 +38,7 @@ def rotation_vector_quaternion(px, py, pz):
     return math.cos(0.5 * th), s * px, s * py, s * pz
 
 
-@njit(cache=True)
+@hot
 def rotate_attitude(y, px, py, pz):
     """In place: the attitude of state y turned by the world rotation vector p,
     q ← normalize(exp(p) ⊗ q)."""
@@ -47,27 +47,27 @@ def rotate_attitude(y, px, py, pz):
     set_attitude(y, q0, q1, q2, q3)
 
 
-@njit(cache=True)
+@hot
 def set_attitude(y, q0, q1, q2, q3):
     """In place: y's quaternion ← (q0, q1, q2, q3) normalised."""
     nq = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
     y[3], y[4], y[5], y[6] = q0 / nq, q1 / nq, q2 / nq, q3 / nq
 
 
-@njit(cache=True)
+@hot
 def axis_of(w, x, yq, z):
     """e3 = R ẑ of the quaternion (w, x, y, z): the body's symmetry axis in the world
     frame (its tilt components from the small quaternion terms directly)."""
     return 2 * (x * z + w * yq), 2 * (yq * z - w * x), 1 - 2 * (x * x + yq * yq)
 
 
-@njit(cache=True)
+@hot
 def body_axis(y):
     """e3 of state y."""
     return axis_of(y[3], y[4], y[5], y[6])
 
 
-@njit(cache=True)
+@hot
 def rotation_columns_xy(y):
     """The first two columns of R: (R00, R01, R10, R11, R20, R21); the z row (the tilt
     terms) from the small quaternion components directly."""
@@ -82,7 +82,7 @@ def rotation_columns_xy(y):
     )
 
 
-@njit(cache=True)
+@hot
 def quaternion_rate(y):
     """dq/dt = ½ (0, ω) ⊗ q for the world angular velocity ω = y[10:13]."""
     wx, wy, wz = y[10], y[11], y[12]
@@ -95,7 +95,7 @@ def quaternion_rate(y):
     )
 
 
-@njit(cache=True)
+@hot
 def quaternion_log(q0, q1, q2, q3):
     """The rotation vector of a unit quaternion, angle in [0, π] (q and −q alike):
     2 atan2(|u|, w) u/|u|, with the series 2/w (1 + |u|²/(3w²)) for tiny |u|."""
@@ -109,7 +109,7 @@ def quaternion_log(q0, q1, q2, q3):
     return q1 * scale, q2 * scale, q3 * scale
 
 
-@njit(cache=True)
+@hot
 def rotate_vector(q0, q1, q2, q3, vx, vy, vz):
     """R(q) v = v + 2w (u × v) + 2 u × (u × v), u the vector part."""
     cx, cy, cz = q2 * vz - q3 * vy, q3 * vx - q1 * vz, q1 * vy - q2 * vx
@@ -117,7 +117,7 @@ def rotate_vector(q0, q1, q2, q3, vx, vy, vz):
     return vx + 2.0 * (q0 * cx + dx), vy + 2.0 * (q0 * cy + dy), vz + 2.0 * (q0 * cz + dz)
 
 
-@njit(cache=True)
+@hot
 def tilt(w, x, yq, z):
     """The inclination α of the body axis from the vertical, atan2(|(e3x, e3y)|, e3z)
     (no 1 − cos loss)."""

@@ -19,7 +19,7 @@ import math
 
 from .contacts import contact_jet, rim_jet
 from .flight import flight_acceleration, free_flight
-from .jit import hot
+from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
 from .roots import safe_step, zero_bracket_end
 from .tolerances import (
@@ -333,8 +333,7 @@ def find_flight_event(
     n = pts.shape[0]
     g = model.gravity
     windowed = use_window(model, window_search, n)
-    for c in range(13):  # (a slice copy would need numba's runtime: jit.hot)
-        y[c] = y0[c]
+    copy_into(y, y0)
     s = 0.0
     vnoise = (
         RATE_NOISE_ULPS

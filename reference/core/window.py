@@ -9,20 +9,19 @@ that does not grow with n."""
 
 import math
 
-from numba import njit
-
+from .jit import hot
 from .rotation import rotation_columns_xy
 from .tolerances import SMALL_N
 
 
-@njit(cache=True)
+@hot
 def use_window(model, window_search, n):
     """Whether only the vertices near the lowest direction are examined: large polygons
     (n > SMALL_N) over flat ground, unless the window search is turned off."""
     return model.flat_ground and window_search and n > SMALL_N
 
 
-@njit(cache=True)
+@hot
 def vertex_window(y, radius, n, K, delta, margin, lift=0.0):
     """The vertices whose P2 can come within `lift` of the ground within δ (the others
     are safe by P2): the index range k0 − half … k0 + half (mod n) around the lowest
@@ -51,7 +50,7 @@ def vertex_window(y, radius, n, K, delta, margin, lift=0.0):
     return int(math.floor(centre / dth + 0.5)), half
 
 
-@njit(cache=True)
+@hot
 def window_offsets(y, radius, n, K, delta, margin, k0):
     """vertex_window(δ) as offsets (lo, hi) from vertex k0 (in (−n/2, n/2])."""
     k1, h1 = vertex_window(y, radius, n, K, delta, margin)
