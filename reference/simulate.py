@@ -26,7 +26,7 @@ from .core.records import (
     RETURN_DONE,
     RETURN_GROW,
 )
-from .core.tolerances import TILT_FLOOR
+from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
 from .scene import Scene
@@ -255,8 +255,8 @@ def status_message(state: np.void, opts: np.void) -> tuple[Status, str]:
             f"contact integration failed: step size below roundoff (at t = {t:.17g})"
         ),
         R.STATUS_FAILED_NO_ADVANCE: (
-            f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0 with contacts "
-            f"{contacts} held)"
+            f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, or "
+            f"{MAX_STALL_STEPS} steps without progress, with contacts {contacts} held)"
         ),
     }
     return _STATUS.get(code, Status.FAILED), messages.get(code, f"loop status {code}")

@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from reference import quaternion as qt
-from reference.core.contacts import contact_jet
+from reference.core.contacts import contact_frame, contact_jet
 from reference.core.flight import (
     flight_acceleration,
     flight_constants,
@@ -140,7 +140,7 @@ def test_vertex_height_bounds_hold_for_every_vertex_over_long_flights(seed):
     for _ in range(25):
         y0 = _random_flight(rng)
         fc = flight_constants(y0, i1, i3)
-        K, B = vertex_height_bounds(y0, fc, 1.0, 1.0)
+        K, B, _ = vertex_height_bounds(y0, fc, 1.0, 1.0)
         ts = np.linspace(0.0, 20.0 / (fc.omega + abs(fc.lam) + 1e-9), 400)
         acc = np.empty((len(ts), len(pts)))
         y = np.empty(13)
@@ -162,5 +162,30 @@ def test_vertex_height_bounds_shrink_with_the_tilt():
     y0[2] = 1.0
     y0[10:13] = [0.0, 0.0, 100.0]
     fc = flight_constants(y0, i1, i3)
-    _, B = vertex_height_bounds(y0, fc, 1.0, 1.0)
+    _, B, _ = vertex_height_bounds(y0, fc, 1.0, 1.0)
     assert B <= 1e-5 * 100.0**3
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_rim_depth_bounds_every_vertex_over_long_flights(seed):
+    """Bounds.depth ≥ how far any vertex of a 64-gon is below the centre of mass, sampled
+    over 20 precession periods of random flights (fast spins and tumbling), and it is
+    tight: within the polygon's sag and 2 % of the radius (20 samples per period) of the
+    largest sampled depth."""
+    rng = np.random.default_rng(seed)
+    scene = make_scene(n=64, rho=0.5)
+    model, pts = core_model(scene)
+    i1, _, i3 = scene.body.inertia_diag
+    for _ in range(25):
+        y0 = _random_flight(rng)
+        fc = flight_constants(y0, i1, i3)
+        depth = vertex_height_bounds(y0, fc, 1.0, 1.0).depth
+        ts = np.linspace(0.0, 20.0 / (fc.omega + abs(fc.lam) + 1e-9), 400)
+        y = np.empty(13)
+        deepest = 0.0
+        for s in ts:
+            free_flight(y0, fc, 1.0, s, y)
+            low = min(contact_frame(y, True, pts, k).gap for k in range(len(pts)))
+            deepest = max(deepest, y[2] - low)
+        assert deepest <= depth
+        assert depth <= deepest + 0.02 + (1 - np.cos(np.pi / 64))

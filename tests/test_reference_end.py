@@ -74,3 +74,58 @@ def test_singularity_time_is_extrapolated_over_alternating_intervals():
     out = namedtuple("Out", "counts impacts")(counts, impacts)
     t_f = extrapolate_singularity(out, t[-1])
     assert t_f == pytest.approx(0.5 + (A + B) / (1 - q), rel=0, abs=1e-14)
+
+
+def test_released_contacts_whose_gaps_still_fall_land_and_the_run_ends():
+    """A fast-spinning 16-gon (γ = 0.5) ends with three adjacent vertices down: after a
+    chatter completion the LCP releases two contacts at zero gap, rate and acceleration
+    whose gaps still fall (the spin's jerk; a tie the acceleration-level LCP cannot
+    see), so the chunk's crossing is located below the clock's resolution.  They land
+    (held with the others) and the run reaches the singularity; it used to cut
+    zero-length chunks forever.  Energy never rose and no vertex went below the ground
+    beyond roundoff."""
+    from reference.options import ReferenceOptions
+    from reference.scene import scene_from_dict
+
+    scene = scene_from_dict(
+        {
+            "restitution": 0.5,
+            "body": {"n": 16, "gyration": 0.5},
+            "initial": {
+                "position": [0.0, 0.0, np.sin(0.02) + 0.01],
+                "rotation_vector": [0.02, 0.0, 0.0],
+                "velocity": [0.0, 0.0, -0.1],
+                "angular_velocity": [0.0, 0.3, 20.0],
+            },
+            "run": {"t_end": 1e4, "max_impacts": 20_000},
+        }
+    )
+    traj = simulate(scene, options=ReferenceOptions(sample_dt=1e4))
+    assert traj.status is Status.SINGULARITY, traj.message
+    assert len(traj.impacts) > 700
+    assert traj.stats.loop_steps < 5 * len(traj.impacts)
+    assert np.all(np.diff(traj.energy) <= 1e-12 * abs(traj.energy[0]))
+    assert traj.stats.max_penetration <= 1e-15  # roundoff of a = 1
+
+
+def test_a_loop_that_stops_advancing_is_ended_by_the_stall_guard():
+    """loop._stalled: MAX_STALL_STEPS steps in a row with the same time and event count
+    end the run; a step that advances time, or records an event, starts the count again."""
+    from reference.core import records as R
+    from reference.core.loop import _stalled
+    from reference.core.output import Output
+    from reference.core.tolerances import MAX_STALL_STEPS
+    from reference.simulate import initial_record
+
+    state = initial_record(np.zeros(13))
+    counts = np.zeros(5, dtype=np.int64)
+    out = Output(
+        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
+        np.zeros((1, 6)), np.zeros(1), counts,
+    )  # fmt: skip
+    state["t_hi"] = 1.0
+    assert not _stalled(state[0], out)  # a new time: the count starts
+    assert not any(_stalled(state[0], out) for _ in range(MAX_STALL_STEPS))
+    counts[R.N_IMPACTS] += 1  # an event: the count starts again
+    assert not any(_stalled(state[0], out) for _ in range(MAX_STALL_STEPS + 1))
+    assert _stalled(state[0], out)

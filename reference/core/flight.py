@@ -103,7 +103,25 @@ def vertex_height_bounds(y0, fc, radius, gravity):
     return Bounds(
         BOUND_MARGIN * K + slack * (w0**2 + wp**2 + wm**2),
         BOUND_MARGIN * B + slack * (w0**3 + wp**3 + wm**3),
+        rim_depth_bound(y0, Lx, Ly, Lz, radius),
     )
+
+
+@hot
+def rim_depth_bound(y0, Lx, Ly, Lz, radius):
+    """The most any vertex can be below the centre of mass during the flight: the rim's
+    depth a sin α, with the axis e3 precessing about L̂ (regular precession), so that
+    e3_z(s) = c + A cos Ωs + S sin Ωs (`_height_terms`) stays within c ± √(A² + S²):
+    sin α ≤ √(1 − m²), m the least |e3_z| over that range (0 if it holds 0).  Bounds
+    every vertex at once for the whole flight, however fast the body spins; a few ulps
+    of margin on the result."""
+    e3x, e3y, e3z = body_axis(y0)
+    c, A, S = _height_terms(e3x, e3y, e3z, Lx, Ly, Lz)
+    R = math.sqrt(A * A + S * S)
+    lo, hi = c - R, c + R
+    m = 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
+    s_max = math.sqrt(max(1.0 - m * m, 0.0))
+    return radius * min(s_max + BOUND_ULPS * EPS, 1.0)
 
 
 @hot
@@ -125,7 +143,7 @@ def bump_gap_bounds(y0, fc, pts, gravity, horizon):
     om = fc.omega
     K = gravity + 2 * V * om + D * om * om
     B = 3 * gravity * om + 3 * V * om * om + D * om**3
-    return Bounds(BOUND_MARGIN * K, BOUND_MARGIN * B)
+    return Bounds(BOUND_MARGIN * K, BOUND_MARGIN * B, math.inf)
 
 
 @hot

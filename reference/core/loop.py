@@ -34,6 +34,7 @@ from .records import (
     RETURN_GROW,
     RETURN_YIELD,
     STATUS_ENERGY_EXHAUSTED,
+    STATUS_FAILED_NO_ADVANCE,
     STATUS_FAILED_NONFINITE,
     STATUS_MAX_IMPACTS,
     STATUS_RUNNING,
@@ -41,7 +42,7 @@ from .records import (
     STATUS_T_END,
     STATUS_TILT_FLOOR,
 )
-from .tolerances import MAX_PERIOD, PERIOD_RATIO_TOL, TILT_FLOOR
+from .tolerances import MAX_PERIOD, MAX_STALL_STEPS, PERIOD_RATIO_TOL, TILT_FLOOR
 from .workspace import new_contact_lists
 
 # rows every step may add at most to impacts, phases and accumulation times
@@ -140,6 +141,20 @@ def _finite(y):
 
 
 @hot
+def _stalled(state, out):
+    """Whether MAX_STALL_STEPS steps in a row have neither advanced time nor recorded an
+    event (impact, phase or accumulation): a loop that cannot advance, ended with
+    STATUS_FAILED_NO_ADVANCE rather than run forever."""
+    c = out.counts
+    events = c[N_IMPACTS] + c[N_PHASES] + c[N_ACCUMULATIONS]
+    if state.t_hi != state.stall_t or events != state.stall_events:
+        state.stall_t, state.stall_events, state.stall_steps = state.t_hi, events, 0
+        return False
+    state.stall_steps += 1
+    return state.stall_steps > MAX_STALL_STEPS
+
+
+@hot
 def loop_step(state, model, pts, opts, stats, out, ws, cs):
     """One step: the run's start, a contact chunk (or the event ending the phase), or a
     flight to its event, after the end checks between phases."""
@@ -181,4 +196,6 @@ def run_events(
         stats.loop_steps += 1
         if state.status == STATUS_RUNNING and not _finite(state.y):
             end_run(state, STATUS_FAILED_NONFINITE, cs.together, 0)
+        elif state.status == STATUS_RUNNING and _stalled(state, out):
+            end_run(state, STATUS_FAILED_NO_ADVANCE, state.active, state.n_active)
     return RETURN_DONE if state.status != STATUS_RUNNING else RETURN_YIELD

@@ -290,6 +290,14 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         stats.horizon_backstops += 1
         s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, r.s, n_crossed)
         _drop_samples_after(out, ns0, state, s_star)
+        if two_sum_add(state.t_hi, state.t_lo, s_star)[0] == state.t_hi:
+            # below the clock's resolution: contacts touching now with no approach
+            # speed and no downward acceleration (a tie the LCP cannot see) whose gaps
+            # still fall: they land, held with the others
+            _cut_chunk(state, ws, s_star)
+            close_contact_phase(state, model, stats, out)
+            activate(state, model, pts, ws, stats, cs.together, n_crossed)
+            return DONE
         return _cut_chunk(state, ws, s_star)
     if r.status == INT_CROSSING:  # an approaching contact reached the ground: its impact next
         stats.contact_chunks += 1

@@ -19,8 +19,9 @@ Response = namedtuple("Response", ["dvx", "dvy", "dvz", "dwx", "dwy", "dwz", "w"
 # What stays fixed along a free flight: L/A (world), the spin rate λ about e3 relative
 # to the precessing frame, |ω| and the precession rate Ω = |L|/A.
 FlightConstants = namedtuple("FlightConstants", ["lax", "lay", "laz", "lam", "wabs", "omega"])
-# Bounds on |g″| and |g‴| of every gap over a flight.
-Bounds = namedtuple("Bounds", ["K", "B"])
+# Bounds on |g″| and |g‴| of every gap over a flight, and on how far below the centre
+# of mass any vertex can be during it (flat ground; inf for the three-point ground).
+Bounds = namedtuple("Bounds", ["K", "B", "depth"])
 # An impact's impulse and the contact's normal velocity before and after it.
 ImpactOutcome = namedtuple("ImpactOutcome", ["impulse", "u_pre", "u_post"])
 # The next event of a free flight: kind (EVENT_*), time s from the flight's start, the
@@ -87,6 +88,9 @@ STATE = np.dtype(
         ("n_info", np.int64),  # contacts involved (simultaneous impact)
         ("info", np.int64, (16,)),
         ("t_singularity", np.float64),  # NaN unless the run reached the singularity
+        ("stall_t", np.float64),  # the time and event count of the last step that
+        ("stall_events", np.int64),  # advanced, and how many steps since have not
+        ("stall_steps", np.int64),
     ]
 )
 

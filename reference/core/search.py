@@ -30,6 +30,8 @@ from .tolerances import (
     POLISH_ITERATIONS,
     POLISH_REL_TOL,
     RATE_NOISE_ULPS,
+    SEARCH_SHRINK,
+    SEARCH_WINDOW_GROW,
     SIMULTANEOUS_FACTOR,
     TINY,
     WINDOW_MAX,
@@ -130,6 +132,20 @@ def circle_step(y, acc, g, radius, B):
 
 
 @hot
+def rim_step(y, gravity, depth, radius):
+    """A step safe for every vertex at once for the rest of the flight: no vertex is more
+    than `depth` (Bounds.depth) below the centre, whose height is a parabola, so none
+    touches before z + v_z δ − g δ²/2 = depth (closed form, cancellation-free); 0 when
+    the centre is that low already.  Near the exact landing time of a spinning disk,
+    whose rim's lowest point does not move with the spin."""
+    h = y[2] - depth - 64.0 * EPS * (abs(y[2]) + radius)
+    if not h > 0.0:
+        return 0.0
+    sq = math.sqrt(y[9] * y[9] + 2.0 * gravity * h)
+    return (y[9] + sq) / gravity if y[9] >= 0.0 else 2.0 * h / (sq - y[9])
+
+
+@hot
 def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res):
     """Examine the vertices near the lowest direction into res and return the cap on the
     step they certify (inf when none is needed).  The touching/lowest vertices and
@@ -145,9 +161,9 @@ def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res
     dlt = min(res[STEP], left, 4.0 * last_dlt)
     while True:
         lo1, hi1 = window_offsets(y, radius, n, K, dlt, 3, k0)
-        if hi1 - lo1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= WINDOW_MAX:
+        if hi1 - lo1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= SEARCH_WINDOW_GROW:
             break
-        dlt *= 0.25
+        dlt *= SEARCH_SHRINK
     for off in range(h + 1, hi1 + 1):
         examine(y, acc, True, pts, (k0 + off) % n, K, B, vnoise, res)
     for off in range(lo1, -h):
@@ -173,6 +189,7 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
         if model.flat_ground:
             k0, _ = vertex_window(y, model.radius, n, K, 0.0, 0)
             examine_window(y, acc, pts, n, K, B, k0, n // 2, vnoise, res)
+            return max(res[STEP], rim_step(y, model.gravity, bounds.depth, model.radius)), last_dlt
         else:
             for k in range(n):
                 examine(y, acc, False, pts, k, K, B, vnoise, res)
@@ -181,6 +198,7 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
     # a few sags (a sin α (1 − cos π/n): the most a vertex sits above the circle's lowest
     # point) of it, the vertices near the lowest direction are examined
     d_c, f0, pn = circle_step(y, acc, model.gravity, model.radius, B)
+    d_c = max(d_c, rim_step(y, model.gravity, bounds.depth, model.radius))
     sag = 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (abs(y[2]) + model.radius)
     if f0 > sag:
         return d_c, last_dlt

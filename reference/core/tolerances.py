@@ -41,11 +41,18 @@ POLISH_REL_TOL = 1e-16
 BRACKET_ITERATIONS = 60
 # Free-flight search iterations before the run is declared stuck.
 MAX_SEARCH_ITERATIONS = 100_000
+# Loop steps in a row that neither advance time nor record an event before the run is
+# ended as unable to advance (a guard: no known case reaches it).
+MAX_STALL_STEPS = 1000
 
 # Large polygons: for n > SMALL_N a search step examines only the vertices near the
 # lowest direction and WINDOW_MAX more on each side (reference.core.search).
 SMALL_N = 32
 WINDOW_MAX = 3
+# A search step may examine SEARCH_WINDOW_GROW vertices beyond those, else its step is
+# shortened by SEARCH_SHRINK until that suffices.
+SEARCH_WINDOW_GROW = 12
+SEARCH_SHRINK = 0.25
 # A contact step adds at most WINDOW_GROW vertices at a time to those it examines, else
 # shortens its chunk (×¼); after WINDOW_ROUNDS rounds it examines every vertex
 # (reference.core.candidates).
