@@ -84,3 +84,14 @@ def angular_momentum(scene: Scene, states: np.ndarray) -> np.ndarray:
 def states_of(traj) -> np.ndarray:
     """(N, 13) sample states of a Trajectory."""
     return np.hstack([traj.position, traj.quaternion, traj.velocity, traj.angular_velocity])
+
+
+def empty_output():
+    """The core's Output with one row per array and zero counts (for calling core
+    functions that take it directly)."""
+    from reference.core.output import Output
+
+    return Output(
+        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
+        np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
+    )  # fmt: skip

@@ -14,8 +14,7 @@ from reference.core import dop853_tableau as tab
 from reference.core.contacts import contact_frame, vertex_lever
 from reference.core.dop853 import INT_CROSSING, INT_DONE, integrate_held
 from reference.core.held import held_rhs, new_work
-from reference.core.output import Output
-from tests.conftest import core_model, make_scene
+from tests.conftest import core_model, empty_output, make_scene
 
 
 def test_tableau_is_scipys():
@@ -67,10 +66,7 @@ def test_integration_is_scipys_dop853_step_for_step(two):
 
     ref = solve_ivp(rhs, (0.0, 0.3), y0, method="DOP853", rtol=rtol, atol=atol)
     y = y0.copy()
-    out = Output(
-        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
-        np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
-    )  # fmt: skip
+    out = empty_output()
     ours = new_work()
     r = integrate_held(
         y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], (0, 1.0, 0), out,
@@ -108,10 +104,7 @@ def test_crossing_is_located_where_scipys_event_finds_it():
     t_ref = min(te[0] for te in ref.t_events if len(te))
     first = [k + 1 for k, te in enumerate(ref.t_events) if len(te) and te[0] == t_ref]
     y = y0.copy()
-    out = Output(
-        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
-        np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
-    )  # fmt: skip
+    out = empty_output()
     watch = np.arange(1, 5, dtype=np.int64)
     r = integrate_held(
         y, 2.0, model, pts, idx, m, rtol, atol, scratch[0], scratch[0], (0, 1.0, 0), out,

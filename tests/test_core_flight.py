@@ -129,23 +129,32 @@ def _random_flight(rng):
     return y0
 
 
+def _long_flights_of_a_64_gon(seed, flights=25, samples=400):
+    """Random flights of a 64-gon (a = 1, g = 1): for each, (contact points, flight
+    constants, vertex_height_bounds, sample times over 20 precession periods, the states
+    there by the closed-form flight)."""
+    rng = np.random.default_rng(seed)
+    scene = make_scene(n=64, rho=0.5)
+    _, pts = core_model(scene)
+    i1, _, i3 = scene.body.inertia_diag
+    for _ in range(flights):
+        y0 = _random_flight(rng)
+        fc = flight_constants(y0, i1, i3)
+        ts = np.linspace(0.0, 20.0 / (fc.omega + abs(fc.lam) + 1e-9), samples)
+        states = np.empty((samples, 13))
+        for i, s in enumerate(ts):
+            free_flight(y0, fc, 1.0, s, states[i])
+        yield pts, fc, vertex_height_bounds(y0, fc, 1.0, 1.0), ts, states
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_vertex_height_bounds_hold_for_every_vertex_over_long_flights(seed):
     """K ≥ max |g″| and B ≥ max |g‴| over 20 precession periods, for every vertex of a
     64-gon: sampled g″ from the gap jets, g‴ by finite differences of them."""
-    rng = np.random.default_rng(seed)
-    scene = make_scene(n=64, rho=0.5)
-    model, pts = core_model(scene)
-    i1, _, i3 = scene.body.inertia_diag
-    for _ in range(25):
-        y0 = _random_flight(rng)
-        fc = flight_constants(y0, i1, i3)
-        K, B, _ = vertex_height_bounds(y0, fc, 1.0, 1.0)
-        ts = np.linspace(0.0, 20.0 / (fc.omega + abs(fc.lam) + 1e-9), 400)
+    for pts, fc, bounds, ts, states in _long_flights_of_a_64_gon(seed):
+        K, B = bounds.K, bounds.B
         acc = np.empty((len(ts), len(pts)))
-        y = np.empty(13)
-        for i, s in enumerate(ts):
-            free_flight(y0, fc, 1.0, s, y)
+        for i, y in enumerate(states):
             a = flight_acceleration(fc, y, 1.0)
             acc[i] = [contact_jet(y, True, pts, k, a).accel for k in range(len(pts))]
         assert np.abs(acc).max() <= K
@@ -172,19 +181,10 @@ def test_rim_depth_bounds_every_vertex_over_long_flights(seed):
     over 20 precession periods of random flights (fast spins and tumbling), and it is
     tight: within the polygon's sag and 2 % of the radius (20 samples per period) of the
     largest sampled depth."""
-    rng = np.random.default_rng(seed)
-    scene = make_scene(n=64, rho=0.5)
-    model, pts = core_model(scene)
-    i1, _, i3 = scene.body.inertia_diag
-    for _ in range(25):
-        y0 = _random_flight(rng)
-        fc = flight_constants(y0, i1, i3)
-        depth = vertex_height_bounds(y0, fc, 1.0, 1.0).depth
-        ts = np.linspace(0.0, 20.0 / (fc.omega + abs(fc.lam) + 1e-9), 400)
-        y = np.empty(13)
+    for pts, _, bounds, _, states in _long_flights_of_a_64_gon(seed):
+        depth = bounds.depth
         deepest = 0.0
-        for s in ts:
-            free_flight(y0, fc, 1.0, s, y)
+        for y in states:
             low = min(contact_frame(y, True, pts, k).gap for k in range(len(pts)))
             deepest = max(deepest, y[2] - low)
         assert deepest <= depth

@@ -8,7 +8,7 @@ import pytest
 from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear
 from reference.simulate import simulate
 from reference.trajectory import Status
-from tests.conftest import angular_momentum, states_of
+from tests.conftest import angular_momentum, empty_output, states_of
 
 CASES = {  # (ρ, γ, q0, p0) of the sweep (n = 3, a = m = g = 1)
     "rho0.15-gamma0.1": (
@@ -113,16 +113,12 @@ def test_a_loop_that_stops_advancing_is_ended_by_the_stall_guard():
     end the run; a step that advances time, or records an event, starts the count again."""
     from reference.core import records as R
     from reference.core.loop import _stalled
-    from reference.core.output import Output
     from reference.core.tolerances import MAX_STALL_STEPS
     from reference.simulate import initial_record
 
     state = initial_record(np.zeros(13))
-    counts = np.zeros(5, dtype=np.int64)
-    out = Output(
-        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
-        np.zeros((1, 6)), np.zeros(1), counts,
-    )  # fmt: skip
+    out = empty_output()
+    counts = out.counts
     state["t_hi"] = 1.0
     assert not _stalled(state[0], out)  # a new time: the count starts
     assert not any(_stalled(state[0], out) for _ in range(MAX_STALL_STEPS))

@@ -100,16 +100,12 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
         return NEEDS_ROWS
     stats.flight_searches += 1
     stats.search_iterations += ev.iterations
-    kk = math.floor(state.t_hi / opts.sample_dt) + 1
-    while True:
-        s = grid_time(kk, opts.sample_dt, state.t_hi, state.t_lo)
-        if s >= ev.s:
-            break
-        if s > 0:
-            free_flight(y, fc, model.gravity, s, ws.y_chunk)
-            hi, lo = two_sum_add(state.t_hi, state.t_lo, s)
-            push_sample(out, hi, lo, ws.y_chunk, model, opts.max_samples)
-        kk += 1
+    k, dt, n = grid_times(state.t_hi, state.t_lo, ev.s, opts.sample_dt, n_grid + 1)
+    for i in range(n):
+        s = grid_time(k + i, dt, state.t_hi, state.t_lo)
+        free_flight(y, fc, model.gravity, s, ws.y_chunk)
+        hi, lo = two_sum_add(state.t_hi, state.t_lo, s)
+        push_sample(out, hi, lo, ws.y_chunk, model, opts.max_samples)
     t0 = state.t_hi
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, ev.s)
     copy_into(y, ws.y_event)

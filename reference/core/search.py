@@ -21,7 +21,7 @@ from .contacts import contact_jet, rim_jet
 from .flight import flight_acceleration, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
-from .roots import safe_step, zero_bracket_end
+from .roots import quadratic_first_root, safe_step, zero_bracket_end
 from .tolerances import (
     BRACKET_ITERATIONS,
     EPS,
@@ -135,14 +135,13 @@ def circle_step(y, acc, g, radius, B):
 def rim_step(y, gravity, depth, radius):
     """A step safe for every vertex at once for the rest of the flight: no vertex is more
     than `depth` (Bounds.depth) below the centre, whose height is a parabola, so none
-    touches before z + v_z δ − g δ²/2 = depth (closed form, cancellation-free); 0 when
+    touches before z + v_z δ − g δ²/2 = depth (`roots.quadratic_first_root`); 0 when
     the centre is that low already.  Near the exact landing time of a spinning disk,
     whose rim's lowest point does not move with the spin."""
     h = y[2] - depth - 64.0 * EPS * (abs(y[2]) + radius)
     if not h > 0.0:
         return 0.0
-    sq = math.sqrt(y[9] * y[9] + 2.0 * gravity * h)
-    return (y[9] + sq) / gravity if y[9] >= 0.0 else 2.0 * h / (sq - y[9])
+    return quadratic_first_root(h, y[9], gravity)
 
 
 @hot
