@@ -63,16 +63,21 @@ class Row:
 # ----------------------------------------------------------------------------- scenes
 
 
-def tumbling(n: int, gamma: float, ground: str = "flat", rho: float = 0.45) -> Scene:
-    """A tilted polygon dropped with a wobble (linear coordinates), run to its end or to
-    20,000 impacts."""
+def tumbling(
+    n: int, gamma: float, ground: str = "flat", rho: float = 0.45, scale: float = 1.0
+) -> Scene:
+    """A tilted polygon dropped with a wobble (linear coordinates, both × scale), run to
+    its end or to 20,000 impacts."""
     return scene_from_dict(
         {
             "name": f"n{n}-g{gamma:g}-{ground}",
             "restitution": gamma,
             "body": {"n": n, "gyration": rho},
             "ground": {"kind": ground, "bump_radius": 0.5},
-            "initial": {"q": [0.012, -0.007, 0.05], "p": [0.2, -0.15, -0.5]},
+            "initial": {
+                "q": [0.012 * scale, -0.007 * scale, 0.05 * scale],
+                "p": [0.2 * scale, -0.15 * scale, -0.5 * scale],
+            },
             "run": {"t_end": 1e4, "max_impacts": 20_000},
         }
     )
@@ -102,9 +107,12 @@ def cases() -> dict[str, Scene]:
     for n in (3, 10, 100, 1000, 10_000):
         for gamma in (0.0, 0.5, 1.0):
             out[f"tumbling n={n} γ={gamma:g} flat"] = tumbling(n, gamma)
-    for n in (3, 25):
-        for gamma in (0.0, 0.5, 1.0):
-            out[f"tumbling n={n} γ={gamma:g} three-point"] = tumbling(n, gamma, "three_point")
+    for gamma in (0.0, 0.5, 1.0):  # (n plays no part on the three-point ground)
+        out[f"tumbling γ={gamma:g} three-point"] = tumbling(3, gamma, "three_point")
+        # a gentler drop, so that elastic bouncing stays on the bumps for 1,600 impacts
+        out[f"tumbling γ={gamma:g} three-point ×0.03"] = tumbling(
+            3, gamma, "three_point", scale=0.03
+        )
     for n in (3, 7, 16, 100):
         for gamma in (0.5, 1.0):
             out[f"fast spin n={n} γ={gamma:g}"] = fast_spin(n, gamma)
@@ -255,7 +263,7 @@ def table(rows: list[list[str]], header: list[str]) -> str:
 
 
 def plain_bouncing(row: Row) -> bool:
-    return row.stats.contact_phases == 0 and row.status in ("max_impacts", "t_end")
+    return row.stats.contact_phases == 0 and row.status in ("max_impacts", "t_end", "left_model")
 
 
 def rate_rows(rows: list[Row]) -> list[list[str]]:

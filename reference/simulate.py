@@ -219,6 +219,7 @@ _STATUS = {
     R.STATUS_SIMULTANEOUS: Status.SIMULTANEOUS_IMPACT,
     R.STATUS_PUSHED: Status.SIMULTANEOUS_IMPACT,
     R.STATUS_MAX_IMPACTS: Status.MAX_IMPACTS,
+    R.STATUS_OFF_FACE: Status.LEFT_MODEL,
 }
 
 
@@ -246,6 +247,10 @@ def status_message(state: np.void, opts: np.void) -> tuple[Status, str]:
         ),
         R.STATUS_MAX_IMPACTS: f"reached max_impacts = {int(opts['max_impacts'])}",
         R.STATUS_FAILED_NONFINITE: f"non-finite state at t = {t:.17g}",
+        R.STATUS_OFF_FACE: (
+            f"bump {contacts[0] if contacts else -1} meets the face's plane outside its rim "
+            f"at t = {t:.17g}: the body has left the bumps (outside the three_point model)"
+        ),
         R.STATUS_FAILED_LCP: (
             f"contact complementarity problem of contacts {contacts} has no solution "
             f"(at t = {t:.17g})"

@@ -29,6 +29,7 @@ class Status(StrEnum):
     SINGULARITY = "singularity"  # all contacts down: energy exhausted (t_singularity set)
     SIMULTANEOUS_IMPACT = "simultaneous_impact"  # undecidable in this model: stopped
     MAX_IMPACTS = "max_impacts"  # impact budget exhausted
+    LEFT_MODEL = "left_model"  # the motion left the model (three_point: off the bumps)
     FAILED = "failed"  # the simulator broke (NaN, solver failure, ...)
 
 

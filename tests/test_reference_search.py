@@ -71,7 +71,9 @@ def _product_event(scene, y, window):
     bounds = flight_bounds(y, fc, model, pts, 10.0)
     out, together = np.empty(13), np.empty(len(pts), dtype=np.int64)
     res = np.empty(5)
-    ev = find_flight_event(y, fc, bounds, model, pts, window, 10.0, 100_000, out, together, res)
+    ev = find_flight_event(
+        y, fc, bounds, model, pts, window, 0.0, 10.0, 100_000, out, together, res
+    )
     return ev, sorted(together[: ev.n_together].tolist())
 
 

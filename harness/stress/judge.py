@@ -24,7 +24,7 @@ FAILED_PENETRATION = 0.5
 # gaps are the linearised ones) get 1e-3 of the energy and 1 % of the length scale.
 TOLERANCES = {"reference": (1e-9, 1e-9), "approximate": (1e-3, 1e-2)}
 # Physics statuses that end a run legitimately before t_end.
-STOPS = {Status.SINGULARITY, Status.SIMULTANEOUS_IMPACT, Status.MAX_IMPACTS}
+STOPS = {Status.SINGULARITY, Status.SIMULTANEOUS_IMPACT, Status.MAX_IMPACTS, Status.LEFT_MODEL}
 
 
 # ----------------------------------------------------------------------------- judging

@@ -17,7 +17,14 @@ import pandas as pd
 
 from .grid import SweepConfig
 
-STATUSES = ("singularity", "simultaneous_impact", "t_end", "max_impacts", "failed")
+STATUSES = (
+    "singularity",
+    "simultaneous_impact",
+    "t_end",
+    "max_impacts",
+    "left_model",
+    "failed",
+)
 
 
 def grid_stats(df: pd.DataFrame, config: SweepConfig) -> pd.DataFrame:

@@ -62,6 +62,18 @@ def contact_frame(y, flat, pts, k):
 
 
 @hot
+def off_face(y, model, pts, k):
+    """Whether contact k meets the face's plane outside its rim, |lever| > a: on the
+    three-point ground a bump beside the body, not under it (the model's contact does
+    not exist there: the body has left the bumps).  Never on flat ground, whose contacts
+    are the vertices themselves."""
+    if model.flat_ground:
+        return False
+    f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
+    return f.rx * f.rx + f.ry * f.ry + f.rz * f.rz > model.radius * model.radius
+
+
+@hot
 def normal_velocity(y, f, flat):
     """g′ = n·(v + ω × r) of the contact with frame f (flat ground: v_z + (ω × r)_z)."""
     wx, wy, wz = y[10], y[11], y[12]

@@ -4,7 +4,14 @@ and the start of the run.  Each returns False when it ended the run (state.statu
 set), True otherwise."""
 
 from .chatter import accumulation_time, completion_speed
-from .contacts import contact_frame, contact_jet, normal_velocity, rate_noise, velocity_scale
+from .contacts import (
+    contact_frame,
+    contact_jet,
+    normal_velocity,
+    off_face,
+    rate_noise,
+    velocity_scale,
+)
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
@@ -13,6 +20,7 @@ from .output import push_accumulation, push_impact, push_sample
 from .records import (
     STATUS_AT_REST,
     STATUS_FAILED_LCP,
+    STATUS_OFF_FACE,
     STATUS_PUSHED,
     STATUS_SIMULTANEOUS,
 )
@@ -69,6 +77,10 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
     contacts to hold: resting ones left at rest or separating slower than the completion
     speed, and the hit one if its chatter is completed."""
     y = state.y
+    for i in range(n_hit):  # a bump beside the body: the model ends there
+        if off_face(y, model, pts, hitting[i]):
+            end_run(state, STATUS_OFF_FACE, hitting[i:], 1)
+            return False
     if n_hit > 1:
         end_run(state, STATUS_SIMULTANEOUS, hitting, n_hit)
         return False

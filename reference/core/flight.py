@@ -14,7 +14,7 @@ import math
 from .jit import hot
 from .records import Bounds, FlightConstants
 from .rotation import body_axis, qmul, rotation_columns_xy, rotation_vector_quaternion
-from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS
+from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS, TINY
 
 
 @hot
@@ -131,19 +131,44 @@ def bump_gap_bounds(y0, fc, pts, gravity, horizon):
         g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴,
     |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2."""
     H = horizon if math.isfinite(horizon) else 1e300
-    v0 = math.sqrt(y0[7] ** 2 + y0[8] ** 2 + y0[9] ** 2)
+    v0 = _speed(y0)
     V = v0 + gravity * H
-    D = 0.0
-    for k in range(pts.shape[0]):
-        d = math.sqrt(
-            (y0[0] - pts[k, 0]) ** 2 + (y0[1] - pts[k, 1]) ** 2 + (y0[2] - pts[k, 2]) ** 2
-        )
-        D = max(D, d)
-    D += v0 * H + 0.5 * gravity * H * H
+    D = _farthest_bump(y0, pts) + v0 * H + 0.5 * gravity * H * H
     om = fc.omega
     K = gravity + 2 * V * om + D * om * om
     B = 3 * gravity * om + 3 * V * om * om + D * om**3
     return Bounds(BOUND_MARGIN * K, BOUND_MARGIN * B, math.inf)
+
+
+@hot
+def _speed(y):
+    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2)
+
+
+@hot
+def _farthest_bump(y, pts):
+    """The largest distance from the centre of mass to a bump."""
+    D = 0.0
+    for k in range(pts.shape[0]):
+        d = math.sqrt((y[0] - pts[k, 0]) ** 2 + (y[1] - pts[k, 1]) ** 2 + (y[2] - pts[k, 2]) ** 2)
+        D = max(D, d)
+    return D
+
+
+@hot
+def bound_segment(y, model, pts):
+    """How long a flight from state y is searched with one set of bounds: for ever on
+    flat ground (`vertex_height_bounds` does not depend on it); on the three-point
+    ground max(|v|, √(2 g D))/g, D the farthest bump's distance: over it the speed at
+    most doubles and the distance to a bump at most triples (plus |v|²/2g), so
+    `bump_gap_bounds` stay near their values at its start (without gravity D/|v|: the
+    distance at most doubles)."""
+    if model.flat_ground:
+        return math.inf
+    g, v, D = model.gravity, _speed(y), _farthest_bump(y, pts)
+    if g > 0.0:
+        return max(v, math.sqrt(2.0 * g * D), TINY) / g
+    return D / v if v > 0.0 else math.inf
 
 
 @hot

@@ -21,11 +21,18 @@ import math
 from numba import njit
 
 from .clock import time_until
+from .contacts import off_face
 from .events import end_run, start
 from .inertia import excess_energy
 from .jit import hot
 from .output import Output
-from .phases import NEEDS_ROWS, begin_contact_phase, contact_step, flight_step
+from .phases import (
+    NEEDS_ROWS,
+    begin_contact_phase,
+    close_contact_phase,
+    contact_step,
+    flight_step,
+)
 from .records import (
     N_ACCUMULATIONS,
     N_IMPACTS,
@@ -37,6 +44,7 @@ from .records import (
     STATUS_FAILED_NO_ADVANCE,
     STATUS_FAILED_NONFINITE,
     STATUS_MAX_IMPACTS,
+    STATUS_OFF_FACE,
     STATUS_RUNNING,
     STATUS_SINGULARITY,
     STATUS_T_END,
@@ -155,6 +163,19 @@ def _stalled(state, out):
 
 
 @hot
+def _held_off_face(state, model, pts, found):
+    """Whether a held contact has slid outside the face's rim (`contacts.off_face`;
+    into found[0]).  An impact there is caught before it is applied
+    (`events.resolve_impact`); a held contact is caught at the end of the step that
+    carried it out."""
+    for i in range(state.n_active):
+        if off_face(state.y, model, pts, state.active[i]):
+            found[0] = state.active[i]
+            return True
+    return False
+
+
+@hot
 def loop_step(state, model, pts, opts, stats, out, ws, cs):
     """One step: the run's start, a contact chunk (or the event ending the phase), or a
     flight to its event, after the end checks between phases."""
@@ -198,4 +219,8 @@ def run_events(
             end_run(state, STATUS_FAILED_NONFINITE, cs.together, 0)
         elif state.status == STATUS_RUNNING and _stalled(state, out):
             end_run(state, STATUS_FAILED_NO_ADVANCE, state.active, state.n_active)
+        elif state.status == STATUS_RUNNING and _held_off_face(state, model, pts, cs.together):
+            if state.in_contact:
+                close_contact_phase(state, model, stats, out)
+            end_run(state, STATUS_OFF_FACE, cs.together, 1)
     return RETURN_DONE if state.status != STATUS_RUNNING else RETURN_YIELD

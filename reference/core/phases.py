@@ -15,7 +15,7 @@ from .clock import grid_time, time_until, two_sum_add
 from .contacts import contact_frame, length_scale, rate_noise, velocity_scale
 from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, integrate_held
 from .events import activate, end_run, hold, resolve_impact
-from .flight import flight_bounds, flight_constants, free_flight
+from .flight import flight_constants, free_flight
 from .held import held_acceleration, held_forces, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
@@ -32,7 +32,7 @@ from .records import (
     STATUS_FAILED_NO_ADVANCE,
     STATUS_FAILED_STUCK,
 )
-from .search import find_flight_event
+from .search import flight_event
 from .tolerances import (
     CONTACT_GAP_RES,
     MAX_SEARCH_ITERATIONS,
@@ -87,10 +87,9 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     y = state.y
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
     fc = flight_constants(y, model.i1, model.i3)
-    bounds = flight_bounds(y, fc, model, pts, remaining)
-    ev = find_flight_event(
-        y, fc, bounds, model, pts, opts.window_search, remaining, MAX_SEARCH_ITERATIONS,
-        ws.y_event, cs.together, ws.res,
+    ev = flight_event(
+        y, fc, model, pts, opts.window_search, remaining, MAX_SEARCH_ITERATIONS, ws.y_event,
+        cs.together, ws.res,
     )  # fmt: skip
     if ev.kind == EVENT_STUCK:
         end_run(state, STATUS_FAILED_STUCK, cs.together, 0)

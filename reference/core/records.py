@@ -108,6 +108,7 @@ STATUS_FAILED_INTEGRATION = 9  # the contact integrator's step fell below roundo
 STATUS_FAILED_NO_ADVANCE = 10  # a contact phase cannot advance before t_end
 STATUS_AT_REST = 11  # singularity at the start: all contacts down and at rest
 STATUS_TILT_FLOOR = 12  # singularity: tilt below TILT_FLOOR after impacts
+STATUS_OFF_FACE = 13  # a contact outside the face's rim (three-point ground): left the bumps
 
 # Counters of a run (reference.stats.RunStats reads them by name).
 STATS = np.dtype(

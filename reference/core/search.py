@@ -18,7 +18,7 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 import math
 
 from .contacts import contact_jet, rim_jet
-from .flight import flight_acceleration, free_flight
+from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
 from .roots import quadratic_first_root, safe_step, zero_bracket_end
@@ -341,17 +341,43 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
 
 
 @hot
+def flight_event(y0, fc, model, pts, window_search, horizon, max_iter, y, together, res):
+    """The first event of the free flight from y0 within `horizon`, searched segment by
+    segment: each with the bounds (`flight.flight_bounds`) of its own length from the
+    state at its start (`flight.bound_segment`: the whole horizon on flat ground, whose
+    bounds hold for ever; on the three-point ground bounds over the whole horizon would
+    grow with its square and cube).  FlightEvent as `find_flight_event`, its iterations
+    summed over the segments."""
+    s0 = 0.0
+    iterations = 0
+    copy_into(y, y0)  # the state at s0 (find_flight_event leaves y at its end)
+    while True:
+        end = min(horizon, s0 + bound_segment(y, model, pts))
+        bounds = flight_bounds(y, fc, model, pts, end - s0)
+        ev = find_flight_event(
+            y0, fc, bounds, model, pts, window_search, s0, end, max_iter, y, together, res
+        )
+        iterations += ev.iterations
+        if ev.kind != EVENT_NONE or not end < horizon:
+            return FlightEvent(ev.kind, ev.s, ev.contact, ev.n_together, iterations)
+        s0 = end
+
+
+@hot
 def find_flight_event(
-    y0, fc, bounds, model, pts, window_search, horizon, max_iter, y, together, res
+    y0, fc, bounds, model, pts, window_search, s_start, horizon, max_iter, y, together, res
 ):
-    """The first event of the free flight from y0 within `horizon`: FlightEvent with y at
-    its time (at the horizon when there is none) and the contacts reached in
-    together[:n_together] (res: 5 floats of scratch)."""
+    """The first event of the free flight from y0 in (s_start, horizon] (bounds valid
+    there): FlightEvent with y at its time (at the horizon when there is none) and the
+    contacts reached in together[:n_together] (res: 5 floats of scratch)."""
     n = pts.shape[0]
     g = model.gravity
     windowed = use_window(model, window_search, n)
-    copy_into(y, y0)
-    s = 0.0
+    s = s_start
+    if s == 0.0:
+        copy_into(y, y0)
+    else:
+        free_flight(y0, fc, g, s, y)
     vnoise = (
         RATE_NOISE_ULPS
         * EPS
