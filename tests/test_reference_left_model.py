@@ -107,7 +107,5 @@ def test_long_flights_over_the_bumps_take_few_search_iterations():
     """The bounds of a flight over the bumps are taken over segments of its own time
     scale (`flight.bound_segment`), not over the time left to t_end (which made them
     grow with its square and cube: 10–260 iterations per flight of this run)."""
-    traj = simulate(
-        _scene(1.0, {"q": [0.012, -0.007, 0.05], "p": [0.2, -0.15, -0.5]}), t_end=1e4
-    )
+    traj = simulate(_scene(1.0, {"q": [0.012, -0.007, 0.05], "p": [0.2, -0.15, -0.5]}), t_end=1e4)
     assert traj.stats.search_iterations_per_impact <= 3.0

@@ -38,8 +38,8 @@ ERROR_EXPONENT = -1.0 / 8.0  # error estimator of order 7
 INT_DONE, INT_LIFT_OFF, INT_FAILED, INT_CROSSING = 0, 1, 2, 3
 # status; s: where the integration stopped (the chunk's end, the lift-off or the
 # crossing); nfev; leaving: index (into the held list) of the contact whose force reached
-# zero
-Integration = namedtuple("Integration", ["status", "s", "nfev", "leaving"])
+# zero; h_next: the step the integration would take next (`_next_step`)
+Integration = namedtuple("Integration", ["status", "s", "nfev", "leaving", "h_next"])
 
 # `st` in this module is a records.SCRATCH record: stages K (13 rows: 12 stages and
 # f(y_new)) of the steps taken and Ks of one-step evaluations, state and scale vectors,
@@ -296,34 +296,46 @@ def integrate_held(
     watch_forces,
     watch,
     n_watch,
+    h_start=0.0,
+    f_ready=False,
 ):
     """Integrate the held motion from y (in place) over [0, s_end] with scipy's adaptive
     DOP853; grid samples at the grid's local times (grid = (k, dt, n): (k + i)·dt from
     the clock, i < n, ascending, inside (0, s_end)), stamped with clock = (t_hi, t_lo) +
     the local time.  With watch_forces, stop where a
     held force reaches zero (INT_LIFT_OFF, y = the state there); with n_watch > 0, where
-    the lowest gap of contacts watch[:n_watch] reaches zero (INT_CROSSING)."""
+    the lowest gap of contacts watch[:n_watch] reaches zero (INT_CROSSING).  The first
+    step is h_start when positive (the previous chunk's h_next), else scipy's estimate;
+    f_ready: st.f and st.lam_cur hold f(y) and the held forces already."""
     f = st.f
-    held_rhs(y, model, pts, idx, m, work, f)
-    nfev = 1
-    for i in range(m):
-        st.lam_cur[i] = work.lam[i]
+    nfev = 0
+    if not f_ready:
+        held_rhs(y, model, pts, idx, m, work, f)
+        nfev = 1
+        for i in range(m):
+            st.lam_cur[i] = work.lam[i]
     if watch_forces:
         i = _most_negative(st.lam_cur, m)
         if i >= 0:
-            return Integration(INT_LIFT_OFF, 0.0, nfev, i)
-    h_abs, n0 = initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st)
-    nfev += n0
+            return Integration(INT_LIFT_OFF, 0.0, nfev, i, 0.0)
+    if h_start > 0.0:
+        h_abs = min(h_start, s_end)
+    else:
+        h_abs, n0 = initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st)
+        nfev += n0
     t = 0.0
     gi = 0
     K, y_new = st.K, st.y_new
+    h_next = h_abs
     while t < s_end:
+        h_try = h_abs
         t_new, h, h_abs, n_step = _accepted_step(
             y, f, t, s_end, h_abs, rtol, atol, model, pts, idx, m, work, st
         )
         nfev += n_step
         if h == 0.0:
-            return Integration(INT_FAILED, t, nfev, -1)
+            return Integration(INT_FAILED, t, nfev, -1, 0.0)
+        h_next = _next_step(h_abs, h_try, h, n_step)
         for i in range(m):
             st.lam_new[i] = work.lam[i]
         leaving = _most_negative(st.lam_new, m) if watch_forces else -1
@@ -346,7 +358,7 @@ def integrate_held(
                 clock, max_samples,
             )  # fmt: skip
             copy_into(y, y_new)
-            return Integration(status, t + sigma, nfev + nf + nf2, leaving)
+            return Integration(status, t + sigma, nfev + nf + nf2, leaving, h_next)
         gi, nf = _grid_samples(
             y, f, t, t_new, grid, gi, model, pts, idx, m, work, st, out, clock, max_samples
         )
@@ -356,4 +368,15 @@ def integrate_held(
         for i in range(m):
             st.lam_cur[i] = st.lam_new[i]
         t = t_new
-    return Integration(INT_DONE, s_end, nfev, -1)
+    return Integration(INT_DONE, s_end, nfev, -1, h_next)
+
+
+@hot
+def _next_step(h_abs, h_try, h, n_step):
+    """The step to start the next chunk with: the controller's proposal, or, when the
+    last step was cut short to end the chunk (h < h_try) at its first try (n_step = one
+    step's stages), the uncut step it had proposed (a step cut to fit says nothing
+    against its full length)."""
+    if h < h_try and n_step == N_STAGES:
+        return max(h_abs, h_try)
+    return h_abs

@@ -127,15 +127,28 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
 
 
 @hot
+def _gaps_settled(y, model, pts, idx, m, work):
+    """work.r = −gaps of contacts idx[:m]; whether each is within its roundoff."""
+    settled = True
+    for i in range(m):
+        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        work.r[i] = -f.gap
+        if abs(f.gap) > f.noise:
+            settled = False
+    return settled
+
+
+@hot
 def project_held(y, model, pts, idx, m, work):
-    """In place: project y onto the constraints of contacts idx[:m]: PROJECTION_PASSES
-    Gauss–Newton passes moving the body by M⁻¹Jᵀ A⁻¹ (−gap) (a translation and a small
-    rotation), then zero normal velocities."""
+    """In place: project y onto the constraints of contacts idx[:m]: up to
+    PROJECTION_PASSES Gauss–Newton passes moving the body by M⁻¹Jᵀ A⁻¹ (−gap) (a
+    translation and a small rotation), until every gap is within its roundoff; then zero
+    normal velocities."""
     for _ in range(PROJECTION_PASSES):
+        if _gaps_settled(y, model, pts, idx, m, work):
+            break
         acc = free_acceleration(y, model.i1, model.i3, model.gravity)
         contact_system(y, model, pts, idx, m, acc, work)
-        for i in range(m):
-            work.r[i] = -contact_frame(y, model.flat_ground, pts, idx[i]).gap
         if not solve_small(work.A, work.r, m, work.lam):
             return False
         dx = dy = dz = px = py = pz = 0.0

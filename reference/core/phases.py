@@ -16,7 +16,7 @@ from .contacts import contact_frame, length_scale, rate_noise, velocity_scale
 from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, integrate_held
 from .events import activate, end_run, hold, resolve_impact
 from .flight import flight_constants, free_flight
-from .held import held_acceleration, held_forces, project_held
+from .held import held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
 from .jit import copy_into, hot
@@ -134,6 +134,7 @@ def begin_contact_phase(state, model, opts):
         y, model.mass, model.gravity
     )
     state.has_trend = False
+    state.h_next = 0.0
 
 
 @hot
@@ -243,14 +244,16 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     """One step of a contact phase: the event that ends it, or one integrated chunk."""
     y = state.y
     gap_res = state.gap_res
-    acc = held_acceleration(y, model, pts, state.active, state.n_active, ws)
+    m = state.n_active
+    held_rhs(y, model, pts, state.active, m, ws, ws.f)  # the chunk's f(y) too
+    for i in range(m):  # the held forces now (ws.lam is reused below)
+        ws.lam_chunk[i] = ws.lam[i]
+        ws.lam_cur[i] = ws.lam[i]
+    acc = (ws.f[7], ws.f[8], ws.f[9], ws.f[10], ws.f[11], ws.f[12])
     ex = touching_candidates(state, model, pts, opts, acc, cs, gap_res)
     if _touching_event(state, model, pts, opts, stats, out, ws, cs, ex.n, gap_res):
         return DONE
     ex, n_near, t_near = set_aside_approaching(cs, ex, rate_noise(y, model.radius), gap_res)
-    m = state.n_active
-    for i in range(m):  # the held forces now (ws.lam is reused below)
-        ws.lam_chunk[i] = ws.lam[i]
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
     h, _ = certified_horizon(state, model, pts, acc, cs, ex, min(remaining, t_near))
     if state.has_trend:
@@ -271,6 +274,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
         ws, grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.near, n_near,
+        state.h_next, True,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     if r.status == INT_FAILED:
@@ -300,11 +304,11 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
     copy_into(y, ws.y_chunk)
-    _, ok = held_forces(y, model, pts, state.active, m, ws)
-    for i in range(m):
-        state.lam_prev[i] = ws.lam[i]
+    for i in range(m):  # the forces at this chunk's start: the next one sees their trend
+        state.lam_prev[i] = ws.lam_chunk[i]
     state.h_prev = h
     state.has_trend = True
+    state.h_next = r.h_next
     if remaining - h <= 0:
         push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
         close_contact_phase(state, model, stats, out)
@@ -318,6 +322,7 @@ def _cut_chunk(state, ws, s):
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s)
     copy_into(state.y, ws.y_chunk)
     state.has_trend = False
+    state.h_next = 0.0
     return DONE
 
 

@@ -81,6 +81,7 @@ STATE = np.dtype(
         ("has_trend", np.bool_),  # lam_prev / h_prev hold the previous chunk's forces
         ("lam_prev", np.float64, (2,)),
         ("h_prev", np.float64),
+        ("h_next", np.float64),  # DOP853's next step at the end of the last chunk (0: none)
         ("started", np.bool_),  # the initial contacts have been resolved
         ("status", np.int64),  # STATUS_* once the run has ended
         ("info_t", np.float64),  # time of the event that ended the run
