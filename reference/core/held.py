@@ -86,7 +86,15 @@ def held_acceleration(y, model, pts, idx, m, work):
     """(v̇, ω̇) with contacts idx[:m] held (forces may be negative: that is the lift-off
     signal); the free acceleration when m = 0."""
     acc, _ = held_forces(y, model, pts, idx, m, work)
-    ax, ay, az, bx, by, bz = acc
+    return add_responses(acc, work, m)
+
+
+@hot
+def add_responses(start, work, m):
+    """start + Σ_i work.lam[i] M⁻¹J_iᵀ over the first m contacts of the contact system
+    (their responses in work.resp): the change of (v, ω) that normal impulses λ_i make,
+    or of (v̇, ω̇) that normal forces make, added to `start` (6 numbers)."""
+    ax, ay, az, bx, by, bz = start
     for i in range(m):
         lam = work.lam[i]
         ax += lam * work.resp[i, 0]
@@ -151,15 +159,7 @@ def project_held(y, model, pts, idx, m, work):
         contact_system(y, model, pts, idx, m, acc, work)
         if not solve_small(work.A, work.r, m, work.lam):
             return False
-        dx = dy = dz = px = py = pz = 0.0
-        for i in range(m):
-            mu = work.lam[i]
-            dx += mu * work.resp[i, 0]
-            dy += mu * work.resp[i, 1]
-            dz += mu * work.resp[i, 2]
-            px += mu * work.resp[i, 3]
-            py += mu * work.resp[i, 4]
-            pz += mu * work.resp[i, 5]
+        dx, dy, dz, px, py, pz = add_responses((0.0, 0.0, 0.0, 0.0, 0.0, 0.0), work, m)
         y[0] += dx
         y[1] += dy
         y[2] += dz
