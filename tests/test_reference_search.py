@@ -69,7 +69,7 @@ def _product_event(scene, y, window):
     model, pts = core_model(scene)
     fc = flight_constants(y, scene.body.inertia_diag[0], scene.body.inertia_diag[2])
     bounds = flight_bounds(y, fc, model, pts, 10.0)
-    out, together = np.empty(13), np.empty(len(pts), dtype=np.int64)
+    out, together = y.copy(), np.empty(len(pts), dtype=np.int64)  # out: the state at 0
     res = np.empty(5)
     ev = find_flight_event(
         y, fc, bounds, model, pts, window, 0.0, 10.0, 100_000, out, together, res

@@ -151,11 +151,15 @@ def contact_jet(y, flat, pts, k, acc):
 
 
 @hot
+def speed(y):
+    """|v|, the speed of the centre of mass."""
+    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2)
+
+
+@hot
 def velocity_scale(y, radius):
     """V = |v| + a|ω|: the largest speed of a rim point (the local velocity unit)."""
-    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + radius * math.sqrt(
-        y[10] ** 2 + y[11] ** 2 + y[12] ** 2
-    )
+    return speed(y) + radius * math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
 
 
 @hot

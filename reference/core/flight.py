@@ -11,6 +11,7 @@ constant, and
 
 import math
 
+from .contacts import speed
 from .jit import hot
 from .records import Bounds, FlightConstants
 from .rotation import body_axis, qmul, rotation_columns_xy, rotation_vector_quaternion
@@ -131,18 +132,13 @@ def bump_gap_bounds(y0, fc, pts, gravity, horizon):
         g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴,
     |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2."""
     H = horizon if math.isfinite(horizon) else 1e300
-    v0 = _speed(y0)
+    v0 = speed(y0)
     V = v0 + gravity * H
     D = _farthest_bump(y0, pts) + v0 * H + 0.5 * gravity * H * H
     om = fc.omega
     K = gravity + 2 * V * om + D * om * om
     B = 3 * gravity * om + 3 * V * om * om + D * om**3
     return Bounds(BOUND_MARGIN * K, BOUND_MARGIN * B, math.inf)
-
-
-@hot
-def _speed(y):
-    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2)
 
 
 @hot
@@ -165,7 +161,7 @@ def bound_segment(y, model, pts):
     distance at most doubles)."""
     if model.flat_ground:
         return math.inf
-    g, v, D = model.gravity, _speed(y), _farthest_bump(y, pts)
+    g, v, D = model.gravity, speed(y), _farthest_bump(y, pts)
     if g > 0.0:
         return max(v, math.sqrt(2.0 * g * D), TINY) / g
     return D / v if v > 0.0 else math.inf

@@ -17,7 +17,7 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 
 import math
 
-from .contacts import contact_jet, rim_jet
+from .contacts import contact_jet, rim_jet, speed
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
@@ -350,7 +350,7 @@ def flight_event(y0, fc, model, pts, window_search, horizon, max_iter, y, togeth
     summed over the segments."""
     s0 = 0.0
     iterations = 0
-    copy_into(y, y0)  # the state at s0 (find_flight_event leaves y at its end)
+    copy_into(y, y0)  # the state at s0 (find_flight_event leaves y at its segment's end)
     while True:
         end = min(horizon, s0 + bound_segment(y, model, pts))
         bounds = flight_bounds(y, fc, model, pts, end - s0)
@@ -368,21 +368,14 @@ def find_flight_event(
     y0, fc, bounds, model, pts, window_search, s_start, horizon, max_iter, y, together, res
 ):
     """The first event of the free flight from y0 in (s_start, horizon] (bounds valid
-    there): FlightEvent with y at its time (at the horizon when there is none) and the
-    contacts reached in together[:n_together] (res: 5 floats of scratch)."""
+    there; y holds the state at s_start on entry): FlightEvent with y at its time (at
+    the horizon when there is none) and the contacts reached in together[:n_together]
+    (res: 5 floats of scratch)."""
     n = pts.shape[0]
     g = model.gravity
     windowed = use_window(model, window_search, n)
     s = s_start
-    if s == 0.0:
-        copy_into(y, y0)
-    else:
-        free_flight(y0, fc, g, s, y)
-    vnoise = (
-        RATE_NOISE_ULPS
-        * EPS
-        * (math.sqrt(y0[7] ** 2 + y0[8] ** 2 + y0[9] ** 2) + model.radius * fc.wabs)
-    )
+    vnoise = RATE_NOISE_ULPS * EPS * (speed(y0) + model.radius * fc.wabs)
     last_dlt = math.inf
     for it in range(max_iter):
         acc = flight_acceleration(fc, y, g)
