@@ -120,7 +120,10 @@ def test_large_n_runs_agree_with_every_vertex_runs(n, n_compare):
 @pytest.mark.parametrize("n,gamma,count", [(200, 0.0, 150), (1000, 0.0, 150), (1000, 0.5, 1500)])
 def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma, count):
     """Rolling and rocking large polygons (γ = 0: one contact phase per impact): contact
-    steps that examine a window of vertices give the impacts of steps that examine all."""
+    steps that examine a window of vertices give the impacts of steps that examine all.
+    The two searches take different steps to the same events, so they differ by
+    roundoff, which the rocking amplifies: for γ = 0.5 from 1e-15 to ~1e-11 over 1,500
+    impacts (the tolerance: 5e-11)."""
     scene = make_scene(
         n=n, gamma=gamma, rho=0.45, q=(0.012, -0.007, 0.05), p=(0.2, -0.15, -0.5),
         t_end=100.0, max_impacts=count,
@@ -131,4 +134,4 @@ def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma,
     assert len(win.impacts) == len(full.impacts) == count
     for a, b in zip(win.impacts, full.impacts, strict=True):
         assert a.contact == b.contact
-        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-11
+        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 5e-11

@@ -24,6 +24,7 @@ from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, Fl
 from .roots import quadratic_first_root, safe_step, zero_bracket_end
 from .tolerances import (
     BRACKET_ITERATIONS,
+    CIRCLE_STEP_REL_TOL,
     EPS,
     GRAZE_FACTOR,
     MIN_STEP_REL,
@@ -68,14 +69,45 @@ def examine(y, acc, flat, pts, k, K, B, vnoise, res):
 
 
 @hot
-def examine_window(y, acc, pts, n, K, B, k0, half, vnoise, res):
-    """Examine vertices k0 − half … k0 + half (mod n, each once), centre first then
-    outwards: the lowest usually bind the step, and a small step found early spares the
-    others their cubic."""
-    for j in range(min(2 * half + 1, n)):
-        off = (j + 1) // 2
-        k = (k0 - off if j % 2 else k0 + off) % n
-        examine(y, acc, True, pts, k, K, B, vnoise, res)
+def likely_binding(y, acc, pts, n, K, first, count, radius):
+    """The vertex of first … first + count − 1 (mod n) whose P2 has the first root: the
+    likeliest to bind the step.  Gaps and rates from the rim jet (linear in the body
+    direction, `contacts.rim_jet`): an ordering only, the examination is exact."""
+    px, py, qx, qy, _, _ = rim_jet(y, acc, radius)
+    inv_a = 1.0 / radius
+    best, best_d = first % n, math.inf
+    for j in range(count):
+        k = (first + j) % n
+        cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
+        g = max(y[2] + cx * px + cy * py, TINY)
+        g1 = y[9] + cx * qx + cy * qy
+        if g + best_d * (g1 - 0.5 * K * best_d) > 0.0:
+            continue  # P2 (concave, positive at 0) still positive at the best root
+        d = quadratic_first_root(g, g1, K)
+        if d < best_d:
+            best, best_d = k, d
+    return best
+
+
+@hot
+def examine_range(y, acc, pts, n, K, B, first, count, vnoise, res, radius):
+    """Examine vertices first … first + count − 1 (mod n, count ≤ n), the likeliest to
+    bind the step first (`likely_binding`): its step, found early, spares the others
+    their cubic (`roots.safe_step` solves it only when it would shorten the step)."""
+    if count <= 0:
+        return
+    lead = likely_binding(y, acc, pts, n, K, first, count, radius)
+    examine(y, acc, True, pts, lead, K, B, vnoise, res)
+    for j in range(count):
+        k = (first + j) % n
+        if k != lead:
+            examine(y, acc, True, pts, k, K, B, vnoise, res)
+
+
+@hot
+def examine_window(y, acc, pts, n, K, B, k0, half, vnoise, res, radius):
+    """Examine vertices k0 − half … k0 + half (mod n, each once)."""
+    examine_range(y, acc, pts, n, K, B, k0 - half, min(2 * half + 1, n), vnoise, res, radius)
 
 
 @hot
@@ -95,7 +127,7 @@ def circle_step(y, acc, g, radius, B):
     rate and acceleration of the body points (a, 0), (0, a) less the centre's.  Over
     |c| = 1, P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ²|r|/2, concave on δ ≥ 0, so its first
     root is bracketed from below by chords and from above by Newton steps.  Returns (the
-    root within 1e-3 from below, F(0) = z − |p|, |p| = a sin α)."""
+    root from below within CIRCLE_STEP_REL_TOL, F(0) = z − |p|, |p| = a sin α)."""
     z, vz = y[2], y[9]
     px, py, qx, qy, rx, ry = rim_jet(y, acc, radius)
     rn = math.sqrt(rx * rx + ry * ry)
@@ -112,7 +144,7 @@ def circle_step(y, acc, g, radius, B):
         lo, flo = hi, fhi
         hi *= 2.0
     for _ in range(100):
-        if hi - lo <= 1e-3 * hi:
+        if hi - lo <= CIRCLE_STEP_REL_TOL * hi:
             break
         # the chord lies below F on [lo, hi] (concavity); the tangent at hi above it
         ux, uy = px + hi * qx, py + hi * qy
@@ -154,7 +186,7 @@ def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res
     that suffices."""
     k0, h0 = vertex_window(y, radius, n, K, 0.0, 2)
     h = min(h0 + WINDOW_MAX, n // 2)
-    examine_window(y, acc, pts, n, K, B, k0, h, vnoise, res)
+    examine_window(y, acc, pts, n, K, B, k0, h, vnoise, res, radius)
     if res[HIT_K] >= 0 or res[LAND_K] >= 0 or 2 * h + 1 >= n:
         return math.inf
     dlt = min(res[STEP], left, 4.0 * last_dlt)
@@ -163,10 +195,8 @@ def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res
         if hi1 - lo1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= SEARCH_WINDOW_GROW:
             break
         dlt *= SEARCH_SHRINK
-    for off in range(h + 1, hi1 + 1):
-        examine(y, acc, True, pts, (k0 + off) % n, K, B, vnoise, res)
-    for off in range(lo1, -h):
-        examine(y, acc, True, pts, (k0 + off) % n, K, B, vnoise, res)
+    examine_range(y, acc, pts, n, K, B, k0 + h + 1, hi1 - h, vnoise, res, radius)
+    examine_range(y, acc, pts, n, K, B, k0 + lo1, -h - lo1, vnoise, res, radius)
     return dlt
 
 
@@ -187,7 +217,7 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
     if not windowed:
         if model.flat_ground:
             k0, _ = vertex_window(y, model.radius, n, K, 0.0, 0)
-            examine_window(y, acc, pts, n, K, B, k0, n // 2, vnoise, res)
+            examine_window(y, acc, pts, n, K, B, k0, n // 2, vnoise, res, model.radius)
             return max(res[STEP], rim_step(y, model.gravity, bounds.depth, model.radius)), last_dlt
         else:
             for k in range(n):

@@ -48,6 +48,10 @@ MAX_STALL_STEPS = 1000
 # Large polygons: for n > SMALL_N a search step examines only the vertices near the
 # lowest direction and WINDOW_MAX more on each side (reference.core.search).
 SMALL_N = 32
+# The circle step of large polygons (reference.core.search.circle_step) solves its
+# bound to this relative tolerance (from below: any value is safe; a looser one
+# shortens the step by as much and saves iterations of the solve).
+CIRCLE_STEP_REL_TOL = 1e-2
 WINDOW_MAX = 3
 # A search step may examine SEARCH_WINDOW_GROW vertices beyond those, else its step is
 # shortened by SEARCH_SHRINK until that suffices.
