@@ -135,3 +135,44 @@ def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma,
     for a, b in zip(win.impacts, full.impacts, strict=True):
         assert a.contact == b.contact
         assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 5e-11
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
+    """The order in which a search step examines vertices (`examine_range`: the
+    likeliest to bind first) changes the step only within the roots' tolerance: it lies
+    between the least of the vertices' safe steps, each computed alone without a cap
+    (`roots.safe_step`: from below, within ROOT_REL_TOL), and that least step's root
+    bound, min/(1 − ROOT_REL_TOL); random states of a 64-gon with the rim just above the
+    ground, spinning fast or tumbling."""
+    from reference.core.contacts import contact_jet
+    from reference.core.flight import flight_acceleration
+    from reference.core.roots import safe_step
+    from reference.core.search import STEP, examine_range
+    from reference.core.tolerances import ROOT_REL_TOL
+
+    scene = make_scene(n=64)
+    model, pts = core_model(scene)
+    i1, _, i3 = scene.body.inertia_diag
+    rng = np.random.default_rng(seed)
+    compared = 0
+    for _ in range(200):
+        y = np.zeros(13)
+        tilt = 10 ** rng.uniform(-3, -0.5)
+        y[3:7] = qt.from_rotation_vector([tilt, 0.0, rng.uniform(-3, 3)])
+        y[2] = np.sin(tilt) * (1 + rng.uniform(0.001, 0.2))
+        y[7:10] = rng.normal(size=3) * 0.3
+        y[10:13] = rng.normal(size=3) * [1.0, 1.0, rng.choice([1.0, 30.0])]
+        fc = flight_constants(y, i1, i3)
+        bounds = flight_bounds(y, fc, model, pts, 10.0)
+        acc = flight_acceleration(fc, y, scene.gravity)
+        res = np.array([np.inf, -1.0, np.inf, -1.0, -1.0])
+        examine_range(y, acc, pts, 64, bounds.K, bounds.B, 0, 64, 1e-14, res, 1.0)
+        alone = []
+        for k in range(64):
+            j = contact_jet(y, True, pts, k, acc)
+            alone.append(safe_step(j.gap, j.rate, j.accel, bounds.K, bounds.B))
+        least = min(alone)
+        assert least <= res[STEP] <= least / (1 - ROOT_REL_TOL)
+        compared += np.isfinite(least)
+    assert compared >= 150
