@@ -27,7 +27,7 @@ import numpy as np
 from reference import geometry
 from reference import quaternion as qt
 from reference.scene import Scene
-from reference.trajectory import ImpactLog, Status, Trajectory
+from reference.trajectory import Status, Trajectory
 
 QUATERNION_NORM_TOLERANCE = 1e-6
 PENETRATION_TOLERANCE = 0.05
@@ -159,7 +159,7 @@ def _first_invalid_impact(traj: Trajectory) -> tuple[float, str] | None:
     if not len(traj.impacts):
         return None
     times = traj.impact_times()
-    impulses = _impact_column(traj, "impulse")
+    impulses = traj.impact_column("impulse")
     bad = ~(np.isfinite(times) & np.isfinite(impulses))
     if not bad.any():
         return None
@@ -167,9 +167,3 @@ def _first_invalid_impact(traj: Trajectory) -> tuple[float, str] | None:
     last = float(traj.t[-1]) if traj.n_samples else 0.0
     t = float(times[i]) if np.isfinite(times[i]) else last
     return t, f"an impact with a non-finite time or impulse (impact {i})"
-
-
-def _impact_column(traj: Trajectory, name: str) -> np.ndarray:
-    if isinstance(traj.impacts, ImpactLog):
-        return traj.impacts.column(name)
-    return np.array([getattr(e, name) for e in traj.impacts], dtype=float)

@@ -14,8 +14,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from harness.cli import main
+from reference.trajectory import Status
 
-STATUSES = {"t_end", "singularity", "simultaneous_impact", "max_impacts", "failed"}
+STATUSES = {s.value for s in Status}
 
 TRIANGLE = """name = "keep"
 gravity = 1.0

@@ -3,8 +3,6 @@ meeting the face's plane outside the rim ends the run `left_model` (before that 
 existed, an elastic disk walked off the bumps and went on colliding its infinite plane
 with them, its centre falling for ever)."""
 
-import math
-
 import numpy as np
 import pytest
 
@@ -12,6 +10,7 @@ from reference.scene import scene_from_dict
 from reference.simulate import simulate
 from reference.trajectory import Status
 from tests.conftest import states_of
+from tests.oracle.body import BodyModel
 
 BUMP = 0.5  # bump radius b (the face's radius a is 1)
 
@@ -29,18 +28,11 @@ def _scene(gamma, initial):
     )
 
 
-def _bump(k):
-    t = 2.0 * math.pi * k / 3.0
-    return np.array([BUMP * math.cos(t), BUMP * math.sin(t), 0.0])
-
-
 def _distance_in_face(state, k):
-    """How far from the centre, in the face's plane, bump k's foot lies (written here:
-    e3 = R(q) ẑ for q = (w, x, y, z))."""
-    w, x, y, z = state[3:7] / np.linalg.norm(state[3:7])
-    e3 = np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
-    d = _bump(k) - state[0:3]
-    return float(np.linalg.norm(d - (d @ e3) * e3))
+    """How far from the centre, in the face's plane, bump k's foot lies: the length of
+    its lever (the in-plane part of b_k − x) by the independent oracle."""
+    oracle = BodyModel.from_scene(_scene(1.0, {"q": [0, 0, 0], "p": [0, 0, 0]}))
+    return float(np.linalg.norm(oracle.contacts(state, [k])[2][0]))
 
 
 def _named_bump(message):

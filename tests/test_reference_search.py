@@ -117,13 +117,15 @@ def test_large_n_runs_agree_with_every_vertex_runs(n, n_compare):
         assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-12
 
 
-@pytest.mark.parametrize("n,gamma,count", [(200, 0.0, 150), (1000, 0.0, 150), (1000, 0.5, 1500)])
-def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma, count):
+@pytest.mark.parametrize(
+    "n,gamma,count,tol", [(200, 0.0, 150, 1e-12), (1000, 0.0, 150, 1e-12), (1000, 0.5, 1500, 5e-11)]
+)
+def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma, count, tol):
     """Rolling and rocking large polygons (γ = 0: one contact phase per impact): contact
     steps that examine a window of vertices give the impacts of steps that examine all.
     The two searches take different steps to the same events, so they differ by
     roundoff, which the rocking amplifies: for γ = 0.5 from 1e-15 to ~1e-11 over 1,500
-    impacts (the tolerance: 5e-11)."""
+    impacts (tolerance 5e-11); for γ = 0 at most 4e-14 over 150 (tolerance 1e-12)."""
     scene = make_scene(
         n=n, gamma=gamma, rho=0.45, q=(0.012, -0.007, 0.05), p=(0.2, -0.15, -0.5),
         t_end=100.0, max_impacts=count,
@@ -134,7 +136,7 @@ def test_large_n_contact_phases_agree_with_every_vertex_contact_phases(n, gamma,
     assert len(win.impacts) == len(full.impacts) == count
     for a, b in zip(win.impacts, full.impacts, strict=True):
         assert a.contact == b.contact
-        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 5e-11
+        assert abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= tol
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -144,18 +146,19 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
     between the least of the vertices' safe steps, each computed alone without a cap
     (`roots.safe_step`: from below, within ROOT_REL_TOL), and that least step's root
     bound, min/(1 − ROOT_REL_TOL); random states of a 64-gon with the rim just above the
-    ground, spinning fast or tumbling."""
+    ground, spinning fast or tumbling.  Where one vertex's step is clearly the least,
+    that vertex sets it."""
     from reference.core.contacts import contact_jet
     from reference.core.flight import flight_acceleration
     from reference.core.roots import safe_step
-    from reference.core.search import STEP, examine_range
+    from reference.core.search import STEP, STEP_K, examine_range
     from reference.core.tolerances import ROOT_REL_TOL
 
     scene = make_scene(n=64)
     model, pts = core_model(scene)
     i1, _, i3 = scene.body.inertia_diag
     rng = np.random.default_rng(seed)
-    compared = 0
+    compared = distinct = 0
     for _ in range(200):
         y = np.zeros(13)
         tilt = 10 ** rng.uniform(-3, -0.5)
@@ -172,7 +175,11 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
         for k in range(64):
             j = contact_jet(y, True, pts, k, acc)
             alone.append(safe_step(j.gap, j.rate, j.accel, bounds.K, bounds.B))
-        least = min(alone)
+        order = np.argsort(alone)
+        least = alone[order[0]]
         assert least <= res[STEP] <= least / (1 - ROOT_REL_TOL)
+        if alone[order[1]] > least / (1 - ROOT_REL_TOL) ** 2:  # a clear least: it sets it
+            assert res[STEP_K] == order[0]
+            distinct += 1
         compared += np.isfinite(least)
-    assert compared >= 150
+    assert compared >= 150 and distinct >= 100

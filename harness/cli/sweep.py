@@ -96,7 +96,8 @@ def register(sub) -> None:
         "--chunk-size",
         type=int_in(1, 1_000_000),
         metavar="C",
-        help="runs per task (default: 25 for linear, 1 for the others)",
+        help="runs per task (default: 25 for the event-driven linear model and reference, "
+        "1 for fixed-step engines)",
     )
     e.add_argument(
         "--out",

@@ -47,7 +47,7 @@ from ..stress.budget import (
 from .criteria import FidelityCriteria, alpha_star, exponent_check, impacts_pass, power_law_fit
 from .exponent import exponent_of
 from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
-from .settings import DEFAULT_BUDGET_S, DEFAULT_DTS, DEFAULT_EPS_GRID, WINDOWS  # noqa: F401
+from .settings import DEFAULT_BUDGET_S, DEFAULT_DTS, DEFAULT_EPS_GRID, WINDOWS
 
 NOT_ENGINES = ("reference", "linear")  # the default engines are every other one
 MESSAGE_CHARS = 300

@@ -144,7 +144,7 @@ def chatter_tail(traj: Trajectory, speed: float) -> np.ndarray:
     (c d c d ..., c c d d d c ...); a slow impact at a contact new to the episode is not
     a tail."""
     c = traj.impact_contacts()
-    slow = np.array([abs(e.v_normal_pre) < speed for e in traj.impacts], dtype=bool)
+    slow = np.abs(traj.impact_column("v_normal_pre")) < speed
     tail = np.zeros(len(c), dtype=bool)
     fast: list[int] = []  # contacts of the last two impacts that were not slow
     episode: set[int] = set()

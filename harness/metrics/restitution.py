@@ -33,8 +33,8 @@ def effective_restitution(traj: Trajectory, gravity: float) -> RestitutionEstima
     (`slow_impact_speed`: slower "impacts" are solver contact flicker or late chatter,
     dominated by resolution and by the other contacts' forces; they say nothing about
     the impact law)."""
-    pre = np.array([e.v_normal_pre for e in traj.impacts], dtype=float)
-    post = np.array([e.v_normal_post for e in traj.impacts], dtype=float)
+    pre = traj.impact_column("v_normal_pre")
+    post = traj.impact_column("v_normal_post")
     fastest = float(np.max(-pre)) if pre.size else 0.0
     v_min = slow_impact_speed(traj.dt, gravity, max(fastest, 0.0))
     use = pre < -v_min

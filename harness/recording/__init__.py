@@ -29,7 +29,6 @@ import rerun as rr
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
-from ..outputs import DEFAULT_RECORDING_FOLDER as DEFAULT_FOLDER  # noqa: F401
 from ..outputs import atomic_write, recording_path
 from .geometry import exaggeration_schedule
 from .layout import SUMMARY, RowRanges, build_blueprint, value_range

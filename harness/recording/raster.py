@@ -127,7 +127,7 @@ def _log_impact_text(rec: rr.RecordingStream, run: RunView) -> None:
     ]
     rec.send_columns(
         f"/{run.name}/impacts/log",
-        [time_column(np.array([e.t for e in imps]))],
+        [time_column(run.trajectory.impact_times())],
         rr.TextLog.columns(text=lines, level=["INFO"] * len(lines)),
     )
 

@@ -10,7 +10,7 @@ Each case runs on every requested simulator (fixed-step engines at one stated dt
 default 1e-4) to the case's t_end, and is judged (`assess`) on:
 
 - finished: the run returned, is not `failed`, has no NaN, and reached t_end or stopped
-  with a physics status (singularity, simultaneous impact, max_impacts);
+  with a physics status (singularity, simultaneous impact, max_impacts, left_model);
 - nan: a non-finite value in its states or energies;
 - energy_gain: max over samples of (E − E0)/|E0|, clipped at 0 (no model here gains
   energy: impacts dissipate or conserve it, flight and frictionless contact conserve it);

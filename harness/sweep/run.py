@@ -82,8 +82,8 @@ def fixed_step_t_end(config: SweepConfig, rho: float, gamma: float, q0, p0) -> f
 
 
 def run_trajectory_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) -> dict:
-    """A simulator other than the linear model, through harness.simulators.run_simulator
-    (its checks and guard), then `exponent_result`."""
+    """A simulator other than the linear model and the reference, through
+    harness.simulators.run_simulator (its checks and guard), then `exponent_result`."""
     from ..simulators import is_fixed_step, run_simulator
 
     t_end = config.t_end
@@ -99,10 +99,13 @@ def run_reference_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) 
     grid): the fit reads the energy before each impact, which the sample after the
     previous event holds (energy is constant in flight and in frictionless contact
     phases).  The reference ends a nonfinite or penetrating state with an explicit
-    status itself, so the engines' guard is not needed; the scene is checked as any."""
+    status itself, so the engines' guard is not needed; the scene is checked as any
+    (`check_scene`)."""
     from reference import ReferenceOptions, simulate
+    from reference.scene import check_scene
 
-    scene = polygon_scene(config, rho, gamma, q0, p0).with_run(t_end=config.t_end)
+    scene = polygon_scene(config, rho, gamma, q0, p0)
+    check_scene(scene)
     traj = simulate(scene, options=ReferenceOptions(sample_dt=config.t_end))
     return exponent_result(traj, scene, config)
 
@@ -137,12 +140,13 @@ def exponent_result(traj, scene, config: SweepConfig) -> dict:
 
 def warm_up(config: SweepConfig) -> None:
     """Import and compile the simulator in this process before a local pool forks, so
-    that workers inherit the compiled code (the linear kernel is numba-compiled: tens of
-    seconds per process when its on-disk cache is stale)."""
-    if config.engine == "linear":
+    that workers inherit the compiled code (the linear kernel and, without its
+    ahead-of-time build, the reference are numba-compiled: tens of seconds per process
+    when the on-disk cache is stale)."""
+    if config.engine in ("linear", "reference"):
         q0, p0 = initial_state(config.seed, 0, 0, 0)
         try:
-            run_linear_sample(config, 0.3, 0.5, q0, p0)
+            sample_runner(config.engine)(config, 0.3, 0.5, q0, p0)
         except Exception:  # best effort: the tasks themselves record any error
             pass
 

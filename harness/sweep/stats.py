@@ -15,16 +15,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from reference.trajectory import Status
+
 from .grid import SweepConfig
 
-STATUSES = (
-    "singularity",
-    "simultaneous_impact",
-    "t_end",
-    "max_impacts",
-    "left_model",
-    "failed",
-)
+STATUSES = tuple(s.value for s in Status)  # every status a run can end with
 
 
 def grid_stats(df: pd.DataFrame, config: SweepConfig) -> pd.DataFrame:
