@@ -67,7 +67,8 @@ class Problem:
 
     def grow(self, max_samples: int) -> None:
         """Double the arrays the loop ran short of: impacts, phases and accumulation
-        times when nearly full (the loop checks them before every step); otherwise the
+        times with fewer than STEP_ROWS free rows (the loop's own test before every
+        step); otherwise the
         samples (the only rows a step itself asks for), up to max_samples rows.  Growing
         the large sample arrays only when they are what is short keeps runs with many
         chatter completions from copying them again and again."""
@@ -76,7 +77,7 @@ class Problem:
         for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES),
                           ("accumulations", N_ACCUMULATIONS)):  # fmt: skip
             arr = getattr(self, name)
-            if len(arr) - c[col] < 8:
+            if len(arr) - c[col] < R.STEP_ROWS:
                 setattr(self, name, _grown(arr, 2 * len(arr)))
                 short = True
         rows = min(2 * len(self.sample_t), max(max_samples, 1))
@@ -275,8 +276,6 @@ def _trajectory(
     state = p.state[0]
     status, message = status_message(state, p.options[0])
     t_sing = float(state["t_singularity"])
-    if int(state["status"]) == R.STATUS_AT_REST:
-        t_sing = float(state["info_t"])  # at rest from the start: the motion ended there
     stats = RunStats.from_counters(
         p.counters[0],
         wall,

@@ -148,7 +148,7 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
     bound, min/(1 − ROOT_REL_TOL); random states of a 64-gon with the rim just above the
     ground, spinning fast or tumbling.  Where one vertex's step is clearly the least,
     that vertex sets it."""
-    from reference.core.contacts import contact_jet
+    from reference.core.contacts import contact_jet, rim_jet
     from reference.core.flight import flight_acceleration
     from reference.core.roots import safe_step
     from reference.core.search import STEP, STEP_K, examine_range
@@ -170,7 +170,8 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
         bounds = flight_bounds(y, fc, model, pts, 10.0)
         acc = flight_acceleration(fc, y, scene.gravity)
         res = np.array([np.inf, -1.0, np.inf, -1.0, -1.0])
-        examine_range(y, acc, pts, 64, bounds.K, bounds.B, 0, 64, 1e-14, res, 1.0)
+        jet = rim_jet(y, acc, 1.0)
+        examine_range(y, acc, jet, pts, 64, bounds.K, bounds.B, 0, 64, 1e-14, res, 1.0)
         alone = []
         for k in range(64):
             j = contact_jet(y, True, pts, k, acc)

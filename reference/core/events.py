@@ -216,6 +216,7 @@ def start(state, model, pts, opts, stats, out, ws, cs):
         )
     if n_rest >= model.all_down:
         end_run(state, STATUS_AT_REST, resting, n_rest)
+        state.t_singularity = state.t_hi  # at rest from the start: the motion ended there
         return False
     for i in range(n_rest):
         ws.cand[i] = resting[i]

@@ -77,7 +77,8 @@ def _height_terms(fx, fy, fz, Lx, Ly, Lz):
 
 @hot
 def vertex_height_bounds(y0, fc, radius, gravity):
-    """(K, B) ≥ max over the flight and over every vertex of |g″| and |g‴|, flat ground.
+    """Bounds (K, B) ≥ max over the flight and over every vertex of |g″| and |g‴|, flat
+    ground, and the rim's deepest reach below the centre (`rim_depth_bound`).
 
     A vertex at body angle θ has height z(s) + a (Rot(L̂, Ωs) w(s))_z with
     w = cos φ f1 + sin φ f2, φ = θ + λs, f1, f2 = R0 ê1, R0 ê2.  With (α_i, β_i, γ_i)
@@ -127,8 +128,8 @@ def rim_depth_bound(y0, Lx, Ly, Lz, radius):
 
 @hot
 def bump_gap_bounds(y0, fc, pts, gravity, horizon):
-    """(K, B) for the three-point ground over a flight of `horizon`: with g = (x − b)·e3
-    and e3 precessing at Ω about L,
+    """Bounds (K, B; depth inf) for the three-point ground over a flight of `horizon`:
+    with g = (x − b)·e3 and e3 precessing at Ω about L,
         g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴,
     |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2."""
     H = horizon if math.isfinite(horizon) else 1e300
@@ -169,7 +170,7 @@ def bound_segment(y, model, pts):
 
 @hot
 def flight_bounds(y0, fc, model, pts, horizon):
-    """(K, B) for the scene's ground (`vertex_height_bounds` or `bump_gap_bounds`)."""
+    """Bounds for the scene's ground (`vertex_height_bounds` or `bump_gap_bounds`)."""
     if model.flat_ground:
         return vertex_height_bounds(y0, fc, model.radius, model.gravity)
     return bump_gap_bounds(y0, fc, pts, model.gravity, horizon)

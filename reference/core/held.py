@@ -14,10 +14,10 @@ vertical angular momentum are untouched."""
 import numpy as np
 
 from .contacts import contact_frame, normal_acceleration, normal_velocity
-from .inertia import apply_impulse, free_acceleration, impulse_response
+from .inertia import free_acceleration, impulse_response
 from .jit import hot
 from .linalg import solve_small
-from .records import SCRATCH, Response
+from .records import SCRATCH
 from .rotation import quaternion_rate, rotate_attitude
 from .tolerances import PROJECTION_PASSES
 
@@ -43,12 +43,6 @@ def _row_dot(geo, i, resp, j):
         + cy * resp[j, 4]
         + cz * resp[j, 5]
     )
-
-
-@hot
-def _response(work, i):
-    r = work.resp
-    return Response(r[i, 0], r[i, 1], r[i, 2], r[i, 3], r[i, 4], r[i, 5], r[i, 6])
 
 
 @hot
@@ -129,8 +123,9 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
         work.r[i] = -normal_velocity(y, f, model.flat_ground)
     if not solve_small(work.A, work.r, m, work.lam):
         return False
-    for i in range(m):
-        apply_impulse(y, _response(work, i), work.lam[i])
+    y[7], y[8], y[9], y[10], y[11], y[12] = add_responses(
+        (y[7], y[8], y[9], y[10], y[11], y[12]), work, m
+    )
     return True
 
 

@@ -7,9 +7,12 @@ explicit status and never guesses:
 
 - two contacts reached within the time resolution, or an impact that would drive a
   held contact into the ground (the paper's rule), end it as undecidable;
-- all contacts down, or the energy above the resting level exhausted to
-  `energy_floor` of its initial value, end it at the singularity, with t_singularity
-  (extrapolated from the geometric sequence of the last impact intervals).
+- all contacts down, the energy above the resting level exhausted to `energy_floor`
+  of its initial value, or the tilt below TILT_FLOOR, end it at the singularity, with
+  t_singularity (extrapolated from the geometric sequence of the last impact
+  intervals);
+- a bump outside the face on the three-point ground ends it `left_model`;
+- a loop that stops advancing (MAX_STALL_STEPS steps at one time) ends it as failed.
 
 Time is a double-double and every phase runs in its own local time, so intervals near
 the singularity keep their digits.  The loop returns to Python after `work_budget`
@@ -49,12 +52,10 @@ from .records import (
     STATUS_SINGULARITY,
     STATUS_T_END,
     STATUS_TILT_FLOOR,
+    STEP_ROWS,
 )
 from .tolerances import MAX_PERIOD, MAX_STALL_STEPS, PERIOD_RATIO_TOL, TILT_FLOOR
 from .workspace import new_contact_lists
-
-# rows every step may add at most to impacts, phases and accumulation times
-STEP_ROWS = 4
 
 
 @hot

@@ -180,3 +180,7 @@ RETURN_GROW = 2  # an output array needs more rows: grow it and call again
 
 # counts[...] of the output arrays: rows written of each, and the overflow flag
 N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS, OVERFLOW = range(5)
+
+# rows every loop step may add at most to impacts, phases and accumulation times (the
+# loop asks for more below it, and Problem.grow grows exactly those)
+STEP_ROWS = 4

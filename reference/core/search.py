@@ -17,7 +17,7 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 
 import math
 
-from .contacts import contact_jet, rim_jet, speed
+from .contacts import contact_jet, rate_noise, rim_jet
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
@@ -30,7 +30,6 @@ from .tolerances import (
     MIN_STEP_REL,
     POLISH_ITERATIONS,
     POLISH_REL_TOL,
-    RATE_NOISE_ULPS,
     SEARCH_SHRINK,
     SEARCH_WINDOW_GROW,
     SIMULTANEOUS_FACTOR,
@@ -69,13 +68,14 @@ def examine(y, acc, flat, pts, k, K, B, vnoise, res):
 
 
 @hot
-def likely_binding(y, acc, pts, n, K, first, count, radius):
-    """The vertex of first … first + count − 1 (mod n) whose P2 has the first root: the
-    likeliest to bind the step.  Gaps and rates from the rim jet (linear in the body
-    direction, `contacts.rim_jet`): an ordering only, the examination is exact."""
-    px, py, qx, qy, _, _ = rim_jet(y, acc, radius)
+def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
+    """The vertex of first … first + count − 1 (mod n) whose P2 has the first root, if
+    before best_d (the step found so far; else `first`): the likeliest to bind the step.
+    Gaps and rates from the rim jet (linear in the body direction, `contacts.rim_jet`):
+    an ordering only, the examination is exact."""
+    px, py, qx, qy, _, _ = jet
     inv_a = 1.0 / radius
-    best, best_d = first % n, math.inf
+    best = first % n
     for j in range(count):
         k = (first + j) % n
         cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
@@ -90,13 +90,13 @@ def likely_binding(y, acc, pts, n, K, first, count, radius):
 
 
 @hot
-def examine_range(y, acc, pts, n, K, B, first, count, vnoise, res, radius):
+def examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius):
     """Examine vertices first … first + count − 1 (mod n, count ≤ n), the likeliest to
     bind the step first (`likely_binding`): its step, found early, spares the others
     their cubic (`roots.safe_step` solves it only when it would shorten the step)."""
     if count <= 0:
         return
-    lead = likely_binding(y, acc, pts, n, K, first, count, radius)
+    lead = likely_binding(y, jet, pts, n, K, first, count, radius, res[STEP])
     examine(y, acc, True, pts, lead, K, B, vnoise, res)
     for j in range(count):
         k = (first + j) % n
@@ -105,9 +105,9 @@ def examine_range(y, acc, pts, n, K, B, first, count, vnoise, res, radius):
 
 
 @hot
-def examine_window(y, acc, pts, n, K, B, k0, half, vnoise, res, radius):
+def examine_window(y, acc, jet, pts, n, K, B, k0, half, vnoise, res, radius):
     """Examine vertices k0 − half … k0 + half (mod n, each once)."""
-    examine_range(y, acc, pts, n, K, B, k0 - half, min(2 * half + 1, n), vnoise, res, radius)
+    examine_range(y, acc, jet, pts, n, K, B, k0 - half, min(2 * half + 1, n), vnoise, res, radius)
 
 
 @hot
@@ -119,7 +119,7 @@ def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
 
 
 @hot
-def circle_step(y, acc, g, radius, B):
+def circle_step(y, jet, g, B):
     """A step safe for every vertex at once, from the circle through them.
 
     A vertex's P3 bound is linear in its body direction c: P3_c(δ) = Z3(δ) + c·u3(δ),
@@ -129,7 +129,7 @@ def circle_step(y, acc, g, radius, B):
     root is bracketed from below by chords and from above by Newton steps.  Returns (the
     root from below within CIRCLE_STEP_REL_TOL, F(0) = z − |p|, |p| = a sin α)."""
     z, vz = y[2], y[9]
-    px, py, qx, qy, rx, ry = rim_jet(y, acc, radius)
+    px, py, qx, qy, rx, ry = jet
     rn = math.sqrt(rx * rx + ry * ry)
     pn = math.sqrt(px * px + py * py)
     f0 = z - pn
@@ -177,16 +177,16 @@ def rim_step(y, gravity, depth, radius):
 
 
 @hot
-def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res):
+def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise, res):
     """Examine the vertices near the lowest direction into res and return the cap on the
     step they certify (inf when none is needed).  The touching/lowest vertices and
     WINDOW_MAX more on each side come first; the step δ they allow holds for the others
     if those outside window(δ) are safe by P2 and those inside have been examined: at
-    most WINDOW_MAX more are, δ being shortened (from 4× the last certified step) until
-    that suffices."""
+    most SEARCH_WINDOW_GROW more are, δ being shortened by SEARCH_SHRINK (from 4× the
+    last certified step) until that suffices."""
     k0, h0 = vertex_window(y, radius, n, K, 0.0, 2)
     h = min(h0 + WINDOW_MAX, n // 2)
-    examine_window(y, acc, pts, n, K, B, k0, h, vnoise, res, radius)
+    examine_window(y, acc, jet, pts, n, K, B, k0, h, vnoise, res, radius)
     if res[HIT_K] >= 0 or res[LAND_K] >= 0 or 2 * h + 1 >= n:
         return math.inf
     dlt = min(res[STEP], left, 4.0 * last_dlt)
@@ -195,8 +195,8 @@ def near_vertices_step(y, acc, pts, radius, n, K, B, left, last_dlt, vnoise, res
         if hi1 - lo1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= SEARCH_WINDOW_GROW:
             break
         dlt *= SEARCH_SHRINK
-    examine_range(y, acc, pts, n, K, B, k0 + h + 1, hi1 - h, vnoise, res, radius)
-    examine_range(y, acc, pts, n, K, B, k0 + lo1, -h - lo1, vnoise, res, radius)
+    examine_range(y, acc, jet, pts, n, K, B, k0 + h + 1, hi1 - h, vnoise, res, radius)
+    examine_range(y, acc, jet, pts, n, K, B, k0 + lo1, -h - lo1, vnoise, res, radius)
     return dlt
 
 
@@ -214,24 +214,23 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
         -1.0,
         -1.0,
     )
-    if not windowed:
-        if model.flat_ground:
-            k0, _ = vertex_window(y, model.radius, n, K, 0.0, 0)
-            examine_window(y, acc, pts, n, K, B, k0, n // 2, vnoise, res, model.radius)
-            return max(res[STEP], rim_step(y, model.gravity, bounds.depth, model.radius)), last_dlt
-        else:
-            for k in range(n):
-                examine(y, acc, False, pts, k, K, B, vnoise, res)
+    if not model.flat_ground:
+        for k in range(n):
+            examine(y, acc, False, pts, k, K, B, vnoise, res)
         return res[STEP], last_dlt
+    jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
+    if not windowed:
+        examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
+        return max(res[STEP], rim_step(y, model.gravity, bounds.depth, model.radius)), last_dlt
     # far from the ground the circle through the vertices gives the step at once; within
     # a few sags (a sin α (1 − cos π/n): the most a vertex sits above the circle's lowest
     # point) of it, the vertices near the lowest direction are examined
-    d_c, f0, pn = circle_step(y, acc, model.gravity, model.radius, B)
+    d_c, f0, pn = circle_step(y, jet, model.gravity, B)
     d_c = max(d_c, rim_step(y, model.gravity, bounds.depth, model.radius))
     sag = 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (abs(y[2]) + model.radius)
     if f0 > sag:
         return d_c, last_dlt
-    cap = near_vertices_step(y, acc, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
+    cap = near_vertices_step(y, acc, jet, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
     if cap < math.inf:
         last_dlt = cap
     return max(min(res[STEP], cap), d_c), last_dlt
@@ -405,7 +404,7 @@ def find_flight_event(
     g = model.gravity
     windowed = use_window(model, window_search, n)
     s = s_start
-    vnoise = RATE_NOISE_ULPS * EPS * (speed(y0) + model.radius * fc.wabs)
+    vnoise = rate_noise(y0, model.radius)  # of the flight's state: |ω| is constant
     last_dlt = math.inf
     for it in range(max_iter):
         acc = flight_acceleration(fc, y, g)

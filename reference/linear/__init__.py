@@ -12,7 +12,7 @@
 
 def __getattr__(name: str):
     """`from reference.linear import simulate_linear` (the public API), loaded on first
-    use so that importing the package does not compile the linear kernel."""
+    use so that importing the package does not import numba and the linear kernel."""
     if name in ("simulate_linear", "run_linear", "run_linear_exponent"):
         from . import simulate
 

@@ -58,6 +58,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..core.clock import time_until
 from ..core.tolerances import EPS  # unit roundoff of a double (one definition)
 
 # The event loop's helpers allocate nothing: they are compiled inline into simulate_kernel
@@ -291,7 +292,7 @@ def _time_left(t_end, t_hi, t_lo, kv, kq):
     """Normalised time from t_hi + t_lo to t_end, t = 2^(kq−kv) t̃ (the scaling of the
     paper, section 2.6, eqs. scaleq and scalep); inf without t_end."""
     if math.isfinite(t_end):
-        return math.ldexp((t_end - t_hi) - t_lo, kv - kq)
+        return math.ldexp(time_until(t_hi, t_lo, t_end), kv - kq)
     return math.inf
 
 
