@@ -40,13 +40,29 @@ BUILTIN_CASES = [
 
 
 def generated_scenes():
-    """Scenes not shipped with the package: γ = 0 (contact phases and lift-offs), small γ
-    three-point ground, a heptagon to the energy floor, a spinning square."""
+    """Scenes not shipped with the package: γ = 0 (contact phases and lift-offs; on the
+    three-point ground also to its end), small γ three-point ground, a heptagon to the
+    energy floor, a spinning square."""
     three = {"ground": "three_point"}
     yield (
         "n3-g0-three-point",
         make_scene(n=3, gamma=0.0, rho=0.62, q=(0.012, -0.004, 0.05), p=(0.1, -0.2, -0.5), **three),
         120,
+    )
+    # rocking over the bumps to the singularity; at impacts beside two held contacts
+    # the disk passes flat over all three (L = 0) while moving: long chunks there
+    yield (
+        "n3-g0-three-point-to-the-end",
+        make_scene(
+            n=3,
+            gamma=0.0,
+            rho=0.45,
+            q=(0.012, -0.007, 0.05),
+            p=(0.2, -0.15, -0.5),
+            t_end=1e4,
+            **three,
+        ),  # fmt: skip
+        None,
     )
     yield (
         "n7-g0-flat",

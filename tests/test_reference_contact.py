@@ -4,6 +4,7 @@ closed form; lift-off where the force crosses zero; no drift."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 
 from reference import quaternion as qt
@@ -144,3 +145,21 @@ def test_impact_ending_a_contact_phase_is_where_the_gap_is_zero():
     for a, b in zip(run.impacts[:n], tight.impacts[:n], strict=True):
         assert a.contact == b.contact
         assert abs(a.t - b.t) <= 1e-11
+
+
+def test_chunk_cap_keeps_the_time_scale_of_a_body_passing_flat_while_moving():
+    """horizon.local_time_cap: with the body flat at the bumps' height (L = |z| + a sin α
+    = 0) and rising at ż = U, the cap is LOCAL_TIME_FRACTION √(L_reach/K) with
+    L_reach = U²/(2K), i.e. F·U/(√2 K) (not √(0/K) = 0, which made chunks of 1e-21 s
+    after impacts beside two held contacts); at rest it is F √(L/K) as before."""
+    from reference.core.horizon import local_time_cap
+    from reference.core.tolerances import LOCAL_TIME_FRACTION as F
+
+    model, _ = core_model(make_scene(n=3, ground="three_point"))
+    K, U = 2.5, 0.02
+    y = np.zeros(13)
+    y[3] = 1.0
+    y[9] = U
+    assert local_time_cap(y, model, K) == pytest.approx(F * U / (np.sqrt(2.0) * K), rel=1e-12)
+    y[9], y[2] = 0.0, 1e-4
+    assert local_time_cap(y, model, K) == pytest.approx(F * np.sqrt(1e-4 / K), rel=1e-12)

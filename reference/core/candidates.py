@@ -95,8 +95,15 @@ def _grow(state, model, pts, acc, cs, ex, lo, hi, m, nlo, nhi, h):
 def certified_horizon(state, model, pts, acc, cs, ex, h):
     """The chunk no free contact should reach the ground within, at most h: the horizon
     of the examined contacts, and (windowed) grown or shortened until window(h) has
-    been examined.  Returns (h, how many contacts were examined)."""
-    h = safe_horizon(cs, 0, ex.n, ex.K, min(h, local_time_cap(state.y, model, ex.K)))
+    been examined.  Returns (h, how many contacts were examined).
+
+    The chunk is capped by the local time scale (`local_time_cap`) or, when longer, by
+    the step the integrator proposed at the end of the last chunk (state.h_next): its
+    error control measures the time the state takes to change (at the default
+    contact_rtol = 1e-12 a step is a few per cent of it), where L and V can only guess,
+    e.g. a disk rocking slowly over the bumps of the three-point ground."""
+    cap = max(local_time_cap(state.y, model, ex.K), state.h_next)
+    h = safe_horizon(cs, 0, ex.n, ex.K, min(h, cap))
     if not ex.windowed:
         return h, ex.n
     n = pts.shape[0]

@@ -16,7 +16,7 @@ import math
 from .jit import hot
 from .records import Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
-from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
+from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTOR, TINY
 
 
 @hot
@@ -173,3 +173,28 @@ def length_scale(y, radius):
     """L = |z| + a sin α: the height of the centre plus the rim's vertical extent."""
     ex, ey, _ = body_axis(y)
     return abs(y[2]) + radius * math.sqrt(ex * ex + ey * ey)
+
+
+@hot
+def length_rate(y, radius):
+    """U = |ż| + a|ω × e3| ≥ |L′|: how fast L = |z| + a sin α may change (a spin about
+    the body's axis leaves it)."""
+    ex, ey, ez = body_axis(y)
+    wx, wy, wz = y[10], y[11], y[12]
+    ux, uy, uz = wy * ez - wz * ey, wz * ex - wx * ez, wx * ey - wy * ex
+    return abs(y[9]) + radius * math.sqrt(ux * ux + uy * uy + uz * uz)
+
+
+@hot
+def time_resolution(noise, rate):
+    """noise / |rate|: how finely the zero of a gap approaching at `rate` can be timed."""
+    return (noise + TINY) / max(-rate, TINY)
+
+
+@hot
+def reached_together(gap, rate, noise, tres0):
+    """Whether a contact approaching (rate < 0) reaches the ground together with one
+    reached now whose time resolution is tres0: its zero, gap/|rate| away, is within
+    SIMULTANEOUS_FACTOR × the sum of their time resolutions (the model cannot order
+    them)."""
+    return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0)

@@ -4,7 +4,7 @@ overshot by much (the lift-off is then located inside the chunk)."""
 
 import math
 
-from .contacts import length_scale, velocity_scale
+from .contacts import length_rate, length_scale, velocity_scale
 from .jit import hot
 from .roots import safe_step
 from .tolerances import (
@@ -25,9 +25,15 @@ def horizon_bound(acc_scale, gravity):
 
 @hot
 def local_time_cap(y, model, K):
-    """LOCAL_TIME_FRACTION of min(√(L/K), ROTATION_TIME_FACTOR a/V): a chunk stays short
-    against the time the body takes to fall its own size and the rim its radius."""
-    t_local = math.sqrt(max(length_scale(y, model.radius), TINY) / K)
+    """LOCAL_TIME_FRACTION of min(√(L_reach/K), ROTATION_TIME_FACTOR a/V): a chunk stays
+    short against the time the body takes to fall the extent it may reach,
+    L_reach = L + U²/(2K) (its size now, `length_scale`, and the rise its rate U =
+    `length_rate` carries it against K), and the time the rim takes to move its radius.
+    The rise keeps the time scale when L passes through zero with the body moving (a
+    disk passing flat over the three bumps at an impact beside two held ones)."""
+    u = length_rate(y, model.radius)
+    reach = length_scale(y, model.radius) + 0.5 * u * u / K
+    t_local = math.sqrt(max(reach, TINY) / K)
     vs = velocity_scale(y, model.radius)
     if vs > 0:
         t_local = min(t_local, ROTATION_TIME_FACTOR * model.radius / vs)

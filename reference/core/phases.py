@@ -12,8 +12,16 @@ from .candidates import (
     touching_candidates,
 )
 from .clock import grid_time, time_until, two_sum_add
-from .contacts import contact_frame, length_scale, rate_noise, velocity_scale
-from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, integrate_held
+from .contacts import (
+    contact_frame,
+    length_rate,
+    length_scale,
+    rate_noise,
+    reached_together,
+    time_resolution,
+    velocity_scale,
+)
+from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, initial_step, integrate_held
 from .events import activate, end_run, hold, resolve_impact
 from .flight import flight_constants, free_flight
 from .held import held_rhs, project_held
@@ -156,11 +164,13 @@ def close_contact_phase(state, model, stats, out):
 @hot
 def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res):
     """A free contact touching while approaching (gap within its roundoff: an impact with
-    the held ones) or at rest accelerating into the ground (gap within max(noise,
+    the held ones, and with every other approaching contact `reached_together` with it,
+    as in flight) or at rest accelerating into the ground (gap within max(noise,
     gap_res): an activation) ends the phase.  Returns True if so."""
     vnoise = rate_noise(state.y, model.radius)
     n_hit = n_land = 0
     hitting = cs.hitting
+    first = -1
     for i in range(n_cand):
         if cs.gap[i] > max(cs.noise[i], gap_res):
             continue
@@ -168,10 +178,12 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
             if cs.gap[i] <= cs.noise[i]:
                 hitting[n_hit] = cs.cand[i]
                 n_hit += 1
+                first = i if first < 0 else first
         elif cs.rate[i] <= vnoise and cs.accel[i] < 0:
             cs.together[n_land] = cs.cand[i]
             n_land += 1
     if n_hit:
+        n_hit = _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res)
         close_contact_phase(state, model, stats, out)
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
@@ -187,10 +199,25 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
 
 
 @hot
-def _set_tolerances(y, model, rtol, atol):
-    """Absolute tolerances of a chunk: rtol × the length scale for positions (over a for
-    the quaternion), rtol × the velocity scale for velocities (over a for ω)."""
-    scale_x = length_scale(y, model.radius) + TINY
+def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res):
+    """Append to cs.hitting the approaching contacts above their roundoff that are
+    `reached_together` with the touching cs.cand[first], each gap known to
+    max(its roundoff, gap_res) (the integrator's resolution of positions in a contact
+    phase); returns the new count."""
+    tres0 = time_resolution(max(cs.noise[first], gap_res), cs.rate[first])
+    for i in range(n_cand):
+        if cs.gap[i] > cs.noise[i] and cs.rate[i] < -vnoise:
+            if reached_together(cs.gap[i], cs.rate[i], max(cs.noise[i], gap_res), tres0):
+                cs.hitting[n_hit] = cs.cand[i]
+                n_hit += 1
+    return n_hit
+
+
+@hot
+def _set_tolerances(y, model, scale_x, rtol, atol):
+    """Absolute tolerances of a chunk: rtol × scale_x for positions (over a for the
+    quaternion), rtol × the velocity scale for velocities (over a for ω)."""
+    scale_x += TINY
     scale_v = velocity_scale(y, model.radius) + TINY
     for c in range(3):
         atol[c] = rtol * scale_x
@@ -198,6 +225,33 @@ def _set_tolerances(y, model, rtol, atol):
         atol[10 + c] = rtol * scale_v / model.radius
     for c in range(3, 7):
         atol[c] = rtol * scale_x / model.radius
+
+
+@hot
+def _prepare_chunk(state, model, pts, opts, stats, ws, h):
+    """The chunk's tolerances (ws.atol, positions on the scale L) and its first step:
+    the previous chunk's h_next, or `_first_step`."""
+    h_start = state.h_next
+    if not h_start > 0.0:
+        h_start, nfev = _first_step(state, model, pts, opts, ws, h)
+        stats.contact_rhs_evals += nfev
+    y = state.y
+    _set_tolerances(y, model, length_scale(y, model.radius), opts.contact_rtol, ws.atol)
+    return h_start
+
+
+@hot
+def _first_step(state, model, pts, opts, ws, h):
+    """The first integrator step of a chunk of length h that follows no other: scipy's
+    estimate (`dop853.initial_step`, f(y) in ws.f) with the extent L + U h the positions
+    may cover as their scale (`length_scale`, `length_rate`).  With L alone (the
+    chunk's tolerance) a body passing flat while moving, L → 0, would start 1e-20 of
+    the chunk short and take dozens of steps to grow.  Returns (h, nfev)."""
+    y = state.y
+    scale_x = length_scale(y, model.radius) + length_rate(y, model.radius) * h
+    _set_tolerances(y, model, scale_x, opts.contact_rtol, ws.atol)
+    return initial_step(y, ws.f, h, opts.contact_rtol, ws.atol, model, pts, state.active,
+                        state.n_active, ws, ws)  # fmt: skip
 
 
 @hot
@@ -267,14 +321,14 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     if _needed(n_grid, out, opts):
         return NEEDS_ROWS
     grid = grid_times(state.t_hi, state.t_lo, h, opts.sample_dt, n_grid + 1)
-    _set_tolerances(y, model, opts.contact_rtol, ws.atol)
+    h_start = _prepare_chunk(state, model, pts, opts, stats, ws, h)
     copy_into(ws.y_start, y)
     copy_into(ws.y_chunk, y)
     ns0 = out.counts[N_SAMPLES]
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
         ws, grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.near, n_near,
-        state.h_next, True,
+        h_start, True,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     if r.status == INT_FAILED:

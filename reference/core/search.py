@@ -17,7 +17,7 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 
 import math
 
-from .contacts import contact_jet, rate_noise, rim_jet
+from .contacts import contact_jet, rate_noise, reached_together, rim_jet, time_resolution
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
@@ -32,7 +32,6 @@ from .tolerances import (
     POLISH_REL_TOL,
     SEARCH_SHRINK,
     SEARCH_WINDOW_GROW,
-    SIMULTANEOUS_FACTOR,
     TINY,
     WINDOW_MAX,
 )
@@ -336,7 +335,7 @@ def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together)
     SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
     flat = model.flat_ground
     j0 = contact_jet(y, flat, pts, k0, acc)
-    tres0 = (j0.noise + TINY) / max(-j0.rate, TINY)
+    tres0 = time_resolution(j0.noise, j0.rate)
     together[0] = k0
     count = 1
     n = pts.shape[0]
@@ -348,7 +347,7 @@ def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together)
         j = contact_jet(y, flat, pts, k, acc)
         if j.rate >= -vnoise:
             continue
-        if j.gap / -j.rate <= SIMULTANEOUS_FACTOR * ((j.noise + TINY) / max(-j.rate, TINY) + tres0):
+        if reached_together(j.gap, j.rate, j.noise, tres0):
             together[count] = k
             count += 1
     return count

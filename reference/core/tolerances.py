@@ -72,8 +72,9 @@ CHATTER_BOUNCE_FLOOR = 100.0
 # integrator resolves positions to ~rtol of the phase's size).
 CONTACT_GAP_RES = 16.0
 # Chunk horizon (reference.core.horizon): K = HORIZON_ACC_FACTOR max|g″| + g over the free
-# contacts; at most LOCAL_TIME_FRACTION of the local time scale √(L/K) and of the time
-# ROTATION_TIME_FACTOR·a/V the rim takes to move its own radius; a force falling at its
+# contacts; at most LOCAL_TIME_FRACTION of the local time scale √(L_reach/K) and of the
+# time ROTATION_TIME_FACTOR·a/V the rim takes to move its own radius, or the integrator's
+# own next step when that is longer (candidates.certified_horizon); a force falling at its
 # current rate may reach zero only after FORCE_TREND_FACTOR chunks of its current value.
 HORIZON_ACC_FACTOR = 2.0
 LOCAL_TIME_FRACTION = 0.25
