@@ -61,7 +61,7 @@ def generated_scenes():
             p=(0.2, -0.15, -0.5),
             t_end=1e4,
             **three,
-        ),  # fmt: skip
+        ),
         None,
     )
     yield (

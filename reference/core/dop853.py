@@ -164,24 +164,21 @@ def dense_state(y, F, x, out):
 
 @hot
 def _lowest_gap(y, model, pts, watch, n_watch):
-    """The smallest gap among contacts watch[:n_watch] at y, and its roundoff."""
-    g, noise = math.inf, 0.0
+    """The smallest gap among contacts watch[:n_watch] at y."""
+    g = math.inf
     for i in range(n_watch):
-        f = contact_frame(y, model.flat_ground, pts, watch[i])
-        if f.gap < g:
-            g, noise = f.gap, f.noise
-    return g, noise
+        g = min(g, contact_frame(y, model.flat_ground, pts, watch[i]).gap)
+    return g
 
 
 @hot
 def _watched_at(y, sigma, h, model, pts, idx, m, work, st, leaving, watch, n_watch):
     """At local time σ of the step (its dense output, state into st.ys): held force
-    `leaving` if ≥ 0 (and 0), else the lowest gap of watch[:n_watch] (and its
-    roundoff)."""
+    `leaving` if ≥ 0, else the lowest gap of watch[:n_watch]."""
     dense_state(y, st.F, sigma / h, st.ys)
     if leaving >= 0:
         held_forces(st.ys, model, pts, idx, m, work)
-        return work.lam[leaving], 0.0
+        return work.lam[leaving]
     return _lowest_gap(st.ys, model, pts, watch, n_watch)
 
 
@@ -190,8 +187,8 @@ def locate_in_step(y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n
     """σ in (0, h] where the watched value (held force `leaving`, or the lowest watched
     gap: v0 > 0 at the step's start, vh ≤ 0 at its end) reaches zero, on the step's
     dense output: Illinois regula falsi with bisection steps, to xtol + 4ε σ, or (a
-    gap) to the first point where the gap is within its roundoff (there it cannot be
-    told from zero: a bracket narrowed further follows noise).  Returns (σ,
+    gap) to a trial point where the gap is exactly zero (a zero found: near it the gap
+    is roundoff, and narrowing the bracket further follows noise).  Returns (σ,
     right-hand-side-like evaluations: the held forces'); st.ys holds the state there."""
     lo, flo, hi, fhi = 0.0, v0, h, vh
     side = 0
@@ -202,7 +199,7 @@ def locate_in_step(y, h, v0, vh, model, pts, idx, m, work, st, leaving, watch, n
         x = 0.5 * (lo + hi) if it % 3 == 2 or flo == fhi else hi - fhi * (hi - lo) / (fhi - flo)
         if not lo < x < hi:
             x = 0.5 * (lo + hi)
-        fx, noise = _watched_at(y, x, h, model, pts, idx, m, work, st, leaving, watch, n_watch)
+        fx = _watched_at(y, x, h, model, pts, idx, m, work, st, leaving, watch, n_watch)
         if fx == 0.0 and leaving < 0:
             return x, 0
         if fx > 0.0:
@@ -349,8 +346,8 @@ def integrate_held(
         if leaving >= 0:
             v0, vh, status = st.lam_cur[leaving], st.lam_new[leaving], INT_LIFT_OFF
         elif n_watch > 0:
-            v0 = _lowest_gap(y, model, pts, watch, n_watch)[0]
-            vh = _lowest_gap(y_new, model, pts, watch, n_watch)[0]
+            v0 = _lowest_gap(y, model, pts, watch, n_watch)
+            vh = _lowest_gap(y_new, model, pts, watch, n_watch)
             status = INT_CROSSING
         if leaving >= 0 or (n_watch > 0 and vh <= 0.0):
             nfev += dense_output(y, y_new, h, model, pts, idx, m, work, st)

@@ -53,14 +53,22 @@ DONE, NEEDS_ROWS = 0, 1
 
 
 @hot
+def _first_grid_point(t_hi, t_lo, dt):
+    """k of the first sample-grid point k·dt after the clock t_hi + t_lo (its local time
+    `clock.grid_time` tested > 0)."""
+    k = math.floor(t_hi / dt) + 1
+    while grid_time(k, dt, t_hi, t_lo) <= 0:
+        k += 1
+    return k
+
+
+@hot
 def grid_count(t_hi, t_lo, s_end, dt):
-    """Number of sample-grid times k·dt inside (t, t + s_end)."""
+    """Number of sample-grid times k·dt inside (t, t + s_end): from the first
+    (`_first_grid_point`), one per dt (an upper bound `grid_times` enumerates)."""
     if not s_end > 0.0:
         return 0
-    k0 = math.floor(t_hi / dt) + 1
-    first = k0 * dt - t_hi - t_lo
-    if first <= 0.0:
-        first += dt
+    first = grid_time(_first_grid_point(t_hi, t_lo, dt), dt, t_hi, t_lo)
     if first >= s_end:
         return 0
     return int(math.ceil((s_end - first) / dt)) + 1
@@ -68,12 +76,10 @@ def grid_count(t_hi, t_lo, s_end, dt):
 
 @hot
 def grid_times(t_hi, t_lo, s_end, dt, limit):
-    """The sample-grid points inside (0, s_end) of local time from t (the rule of
-    `grid_count`, each time tested; at most `limit`): (k, dt, n), the points
+    """The sample-grid points inside (0, s_end) of local time from t (from
+    `_first_grid_point`, each time tested; at most `limit`): (k, dt, n), the points
     (k + i)·dt, i < n, as `dop853.integrate_held` reads them (`clock.grid_time`)."""
-    kk = math.floor(t_hi / dt) + 1
-    while grid_time(kk, dt, t_hi, t_lo) <= 0:
-        kk += 1
+    kk = _first_grid_point(t_hi, t_lo, dt)
     n = 0
     while n < limit and grid_time(kk + n, dt, t_hi, t_lo) < s_end:
         n += 1
@@ -231,25 +237,25 @@ def _set_tolerances(y, model, scale_x, rtol, atol):
 def _prepare_chunk(state, model, pts, opts, stats, ws, h):
     """The chunk's tolerances (ws.atol, positions on the scale L) and its first step:
     the previous chunk's h_next, or `_first_step`."""
+    y = state.y
+    L = length_scale(y, model.radius)
     h_start = state.h_next
     if not h_start > 0.0:
-        h_start, nfev = _first_step(state, model, pts, opts, ws, h)
+        h_start, nfev = _first_step(state, model, pts, opts, ws, h, L)
         stats.contact_rhs_evals += nfev
-    y = state.y
-    _set_tolerances(y, model, length_scale(y, model.radius), opts.contact_rtol, ws.atol)
+    _set_tolerances(y, model, L, opts.contact_rtol, ws.atol)
     return h_start
 
 
 @hot
-def _first_step(state, model, pts, opts, ws, h):
+def _first_step(state, model, pts, opts, ws, h, L):
     """The first integrator step of a chunk of length h that follows no other: scipy's
     estimate (`dop853.initial_step`, f(y) in ws.f) with the extent L + U h the positions
-    may cover as their scale (`length_scale`, `length_rate`).  With L alone (the
-    chunk's tolerance) a body passing flat while moving, L → 0, would start 1e-20 of
-    the chunk short and take dozens of steps to grow.  Returns (h, nfev)."""
+    may cover as their scale (`length_rate`).  With L alone (the chunk's tolerance) a
+    body passing flat while moving, L → 0, would start 1e-20 of the chunk short and take
+    dozens of steps to grow.  Returns (h, nfev)."""
     y = state.y
-    scale_x = length_scale(y, model.radius) + length_rate(y, model.radius) * h
-    _set_tolerances(y, model, scale_x, opts.contact_rtol, ws.atol)
+    _set_tolerances(y, model, L + length_rate(y, model.radius) * h, opts.contact_rtol, ws.atol)
     return initial_step(y, ws.f, h, opts.contact_rtol, ws.atol, model, pts, state.active,
                         state.n_active, ws, ws)  # fmt: skip
 
