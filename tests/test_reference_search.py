@@ -184,3 +184,123 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
             distinct += 1
         compared += np.isfinite(least)
     assert compared >= 150 and distinct >= 100
+
+
+def _circle_bound(delta, y, jet, g, B):
+    """F(δ) = Z3(δ) − |p + δq| − δ²|r|/2 of `circle_step`'s docstring, written out."""
+    p, q, r = np.array(jet[0:2]), np.array(jet[2:4]), np.array(jet[4:6])
+    z3 = y[2] + y[9] * delta - 0.5 * g * delta**2 - B * delta**3 / 6
+    return z3 - np.linalg.norm(p + delta * q) - 0.5 * delta**2 * np.linalg.norm(r)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_circle_step_is_within_its_tolerance_below_the_circle_bound_root(seed):
+    """The circle step of a 1000-gon lies below the first root of its bound F and within
+    CIRCLE_STEP_REL_TOL of it (root by scipy's brentq on F written out), the rim 1e-13
+    … 1e-2 above the ground, spinning fast or tumbling, falling or rising.  A root
+    within roundoff of the bracket's far end used to hold the chords there and end
+    the solve at 0 after 100 evaluations."""
+    from scipy.optimize import brentq
+
+    from reference.core.contacts import rim_jet
+    from reference.core.flight import flight_acceleration
+    from reference.core.search import circle_step
+    from reference.core.tolerances import CIRCLE_STEP_REL_TOL
+
+    scene = make_scene(n=1000)
+    model, pts = core_model(scene)
+    i1, _, i3 = scene.body.inertia_diag
+    rng = np.random.default_rng(seed)
+    tiny = 0
+    for _ in range(300):
+        y = np.zeros(13)
+        tilt = 10 ** rng.uniform(-3, -0.5)
+        y[3:7] = qt.from_rotation_vector([tilt, 0.0, rng.uniform(-3, 3)])
+        height = 10 ** rng.uniform(-13, -2)
+        y[2] = np.sin(tilt) + height
+        y[7:10] = rng.normal(size=3) * 0.3
+        y[9] = -abs(y[9]) - 1.0 if height < 1e-9 else y[9]
+        y[10:13] = rng.normal(size=3) * [1.0, 1.0, rng.choice([1.0, 30.0])]
+        if height < 1e-9 and rng.uniform() < 0.5:  # tilting about x, q ∥ p: F nearly
+            y[3:7] = qt.from_rotation_vector([tilt, 0.0, 0.0])  # linear to its root
+            y[10:13] = [rng.choice([-1.0, 1.0]), 0.0, 0.0]
+        fc = flight_constants(y, i1, i3)
+        bounds = flight_bounds(y, fc, model, pts, 10.0)
+        jet = rim_jet(y, flight_acceleration(fc, y, scene.gravity), 1.0)
+        step, f0, _ = circle_step(y, jet, scene.gravity, bounds.B)
+        if not f0 > 0:
+            continue
+        hi = 1e-14
+        while _circle_bound(hi, y, jet, scene.gravity, bounds.B) > 0:
+            hi *= 2
+        root = brentq(_circle_bound, 0.0, hi, args=(y, jet, scene.gravity, bounds.B), xtol=1e-300,
+                      rtol=1e-15)  # fmt: skip
+        slack = 1e-5 * root if height < 1e-9 else 1e-12 * root  # F's roundoff at the root
+        assert (1 - CIRCLE_STEP_REL_TOL) * root - slack <= step <= root + slack
+        tiny += height < 1e-9
+    assert tiny >= 40
+
+
+def test_others_safe_time_ends_before_any_other_contact_reaches_the_ground():
+    """Just after a vertex of a heptagon has hit and is moving away, the time the other
+    vertices are certified safe for (`_others_safe_time`, the hit vertex bounded from
+    the safe side as the search bounds it) ends before any vertex reaches the ground:
+    gaps of the closed-form flight sampled over it (independent geometry) stay above
+    the roundoff; it is positive, the separating vertex not standing in the way."""
+    from reference.core.contacts import contact_jet, rate_noise
+    from reference.core.flight import flight_acceleration
+    from reference.core.search import _others_safe_time
+
+    scene = make_scene(n=7)
+    model, pts = core_model(scene)
+    i1, _, i3 = scene.body.inertia_diag
+    rng = np.random.default_rng(7)
+    checked = 0
+    for _ in range(200):
+        y = np.zeros(13)
+        tilt = 10 ** rng.uniform(-2, -0.5)
+        y[3:7] = qt.from_rotation_vector([tilt, 0.0, rng.uniform(-3, 3)])
+        y[10:13] = rng.normal(size=3) * [1.0, 1.0, rng.choice([1.0, 20.0])]
+        y[2] = 1.0
+        k = int(np.argmin(gaps(scene, y)))
+        y[2] -= gaps(scene, y)[k]  # vertex k at the ground
+        fc = flight_constants(y, i1, i3)
+        acc = flight_acceleration(fc, y, scene.gravity)
+        j = contact_jet(y, True, pts, k, acc)
+        y[9] += 0.3 - j.rate  # vertex k moving away at 0.3
+        fc = flight_constants(y, i1, i3)
+        acc = flight_acceleration(fc, y, scene.gravity)
+        bounds = flight_bounds(y, fc, model, pts, 10.0)
+        end = 10.0
+        t = _others_safe_time(y, acc, model, pts, k, end, bounds.K, bounds.B, False,
+                              rate_noise(y, 1.0))  # fmt: skip
+        assert t > 0
+        others = np.delete(np.arange(7), k)
+        for s in np.linspace(0.0, t, 200)[1:]:
+            assert gaps(scene, flight(scene, y, s))[others].min() > -1e-15
+        checked += t < end
+    assert checked >= 150
+
+
+def test_a_polygon_rolling_down_its_vertices_finds_each_impact_in_the_first_search_step():
+    """A 100-gon spinning fast, tilted, γ = 0.5: its vertices hit one after another, each
+    with the last one still touching and moving away.  The bracket shortcut certifies
+    the others until the next vertex's zero from the first search step (it used to
+    wait a step for the last vertex to lift off, one per impact): under 0.5 per
+    impact, where every-vertex and window searches agree on the impacts."""
+    import math
+
+    scene = Scene(
+        name="spin", body=Body(n=100, gyration=0.5), ground=Ground(), restitution=0.5,
+        initial=InitialState(
+            position=(0.0, 0.0, math.sin(0.02) + 0.01), rotation_vector=(0.02, 0.0, 0.0),
+            velocity=(0.0, 0.0, -0.1), angular_velocity=(0.0, 0.3, 20.0),
+        ),
+        run=RunSettings(t_end=100.0, max_impacts=1000),
+    )  # fmt: skip
+    traj = simulate(scene)
+    assert len(traj.impacts) == 1000
+    assert traj.stats.search_iterations_per_impact < 0.5
+    full = simulate(scene, options=ReferenceOptions(window_search=False))
+    for a, b in zip(traj.impacts[:20], full.impacts[:20], strict=True):  # then chaos
+        assert a.contact == b.contact and abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-14

@@ -21,7 +21,7 @@ from .contacts import contact_jet, rate_noise, reached_together, rim_jet, time_r
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
-from .roots import quadratic_first_root, safe_step, zero_bracket_end
+from .roots import quadratic_first_root, quadratic_taylor_root, safe_step, zero_bracket_end
 from .tolerances import (
     BRACKET_ITERATIONS,
     CIRCLE_STEP_REL_TOL,
@@ -111,10 +111,32 @@ def examine_window(y, acc, jet, pts, n, K, B, k0, half, vnoise, res, radius):
 
 @hot
 def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
+    """F(x) = Z3(x) − |p + x q| − x²|r|/2 (`circle_step`)."""
     ux, uy = px + x * qx, py + x * qy
     return (
         z + x * (vz - x * (0.5 * g + x * B / 6.0)) - math.sqrt(ux * ux + uy * uy) - 0.5 * x * x * rn
     )
+
+
+@hot
+def _circle_slope(x, vz, g, B, px, py, qx, qy, rn):
+    """F′(x) (`_circle_F`)."""
+    ux, uy = px + x * qx, py + x * qy
+    un = math.sqrt(ux * ux + uy * uy)
+    d = vz - x * (g + 0.5 * x * B + rn)
+    return d - (ux * qx + uy * qy) / un if un > 0.0 else d
+
+
+@hot
+def _circle_bracket(f0, vz, g, B, px, py, qx, qy, rn):
+    """A first step past F's root: the root of F(0) + F′(0) h − (g + |r|) h²/2 ≥ F(h)
+    (Z3 below its Taylor quadratic, the norm below its tangent); without gravity and
+    rising, a guess for `circle_step` to double."""
+    d0 = _circle_slope(0.0, vz, g, B, px, py, qx, qy, rn)
+    h = quadratic_first_root(f0, d0, g + rn)
+    if not h < math.inf:
+        h = f0 / max(abs(d0) + math.sqrt(qx * qx + qy * qy), TINY)
+    return max(h, TINY)
 
 
 @hot
@@ -125,8 +147,9 @@ def circle_step(y, jet, g, B):
     Z3 = z + v_z δ − g δ²/2 − B δ³/6, u3 = p + δ q + δ² r/2 with p, q, r the height,
     rate and acceleration of the body points (a, 0), (0, a) less the centre's.  Over
     |c| = 1, P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ²|r|/2, concave on δ ≥ 0, so its first
-    root is bracketed from below by chords and from above by Newton steps.  Returns (the
-    root from below within CIRCLE_STEP_REL_TOL, F(0) = z − |p|, |p| = a sin α)."""
+    root is bracketed (`_circle_bracket`, else by doubling) and closed from below by
+    chords and from above by Newton steps.  Returns (the root from below within
+    CIRCLE_STEP_REL_TOL, F(0) = z − |p|, |p| = a sin α)."""
     z, vz = y[2], y[9]
     px, py, qx, qy, rx, ry = jet
     rn = math.sqrt(rx * rx + ry * ry)
@@ -135,31 +158,46 @@ def circle_step(y, jet, g, B):
     if f0 <= 0.0:
         return 0.0, f0, pn
     lo, flo = 0.0, f0
-    hi = max(f0 / max(abs(vz) + math.sqrt(qx * qx + qy * qy), TINY), TINY)
+    hi = _circle_bracket(f0, vz, g, B, px, py, qx, qy, rn)
     for _ in range(2000):
         fhi = _circle_F(hi, z, vz, g, B, px, py, qx, qy, rn)
         if fhi < 0.0:
             break
         lo, flo = hi, fhi
         hi *= 2.0
+    push = 0
     for _ in range(100):
         if hi - lo <= CIRCLE_STEP_REL_TOL * hi:
             break
-        # the chord lies below F on [lo, hi] (concavity); the tangent at hi above it
-        ux, uy = px + hi * qx, py + hi * qy
-        un = math.sqrt(ux * ux + uy * uy)
-        d = vz - hi * (g + 0.5 * hi * B) - hi * rn
-        if un > 0.0:
-            d -= (ux * qx + uy * qy) / un
+        d = _circle_slope(hi, vz, g, B, px, py, qx, qy, rn)
+        chord = _pushed_chord(lo, flo, hi, fhi, push)
         newton = hi - fhi / d if d < 0.0 else -1.0
-        for x in (lo + (hi - lo) * flo / (flo - fhi), newton):
+        for x in (chord, newton):
             if lo < x < hi:
                 fx = _circle_F(x, z, vz, g, B, px, py, qx, qy, rn)
                 if fx >= 0.0:
                     lo, flo = x, fx
                 else:
                     hi, fhi = x, fx
+                    if x == chord:
+                        push += 1
     return lo, f0, pn
+
+
+@hot
+def _pushed_chord(lo, flo, hi, fhi, push):
+    """The chord's root on [lo, hi], kept half of CIRCLE_STEP_REL_TOL inside hi once a
+    chord has landed past the root (`push` ≥ 1) or rounds onto hi, and at most the
+    midpoint once that too has (push ≥ 2).  A chord lies below the concave F, so it
+    lands past the root only by roundoff: the root is then within roundoff of hi, where
+    chords alone would close the bracket an ulp at a time (observed: 100 evaluations
+    for a step of 1e-12 s); the midpoint, for F itself at roundoff level."""
+    chord = lo + (hi - lo) * flo / (flo - fhi)
+    if push >= 2:
+        return min(chord, 0.5 * (lo + hi))
+    if push == 1 or not chord < hi:
+        return min(chord, hi - 0.5 * CIRCLE_STEP_REL_TOL * hi)
+    return chord
 
 
 @hot
@@ -236,23 +274,30 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
 
 
 @hot
-def _others_safe_until(y, acc, model, pts, k, end, K, B, windowed):
-    """Whether every contact but k stays above the ground over [0, end] (its lower bound
-    max(P2, P3) has no root before end; a touching contact is not certified).  With the
-    window search only the vertices of window(end) are examined: the others are safe
-    over [0, end] by P2 (`vertex_window`)."""
+def _others_safe_time(y, acc, model, pts, k, end, K, B, windowed, vnoise):
+    """How long every contact but k certainly stays above the ground, up to end: the
+    least root of their lower bounds max(P2, P3) (`roots.safe_step`); a touching
+    contact moving away faster than the rate noise counts from the safe side as
+    `examine` bounds it (gap max(g, 0) + roundoff), any other touching contact gives 0.
+    With the window search only the vertices of window(end) are examined: the others
+    are safe over [0, end] by P2 (`vertex_window`)."""
     n = pts.shape[0]
     first, half = 0, n // 2
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
+    t = end
     for i in range(min(2 * half + 1, n)):
         j = (first - half + i) % n
         if j == k:
             continue
         jt = contact_jet(y, model.flat_ground, pts, j, acc)
-        if jt.gap <= jt.noise or safe_step(jt.gap, jt.rate, jt.accel, K, B, end) < end:
-            return False
-    return True
+        g = jt.gap
+        if g <= jt.noise:
+            if not jt.rate > vnoise:
+                return 0.0
+            g = max(g, 0.0) + jt.noise
+        t = min(t, safe_step(g, jt.rate, jt.accel, K, B, t))
+    return t
 
 
 @hot
@@ -282,9 +327,11 @@ def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
 def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, windowed, res, y):
     """The shortcut of a transversal approach: when the contact that sets the step
     (res[STEP_K]) is approaching with its first zero bracketed in [step, end]
-    (roots.zero_bracket_end) and every other contact is safe until end, that zero is the
-    flight's next event: returns its time with y there (the impact test of `examine`
-    holds there), or −1 when the shortcut does not apply (y then undefined)."""
+    (roots.zero_bracket_end) and every other contact is safe until that zero
+    (`_others_safe_time`: neighbours of a polygon rolling down reach the ground just
+    after it, and their bounds may reach end), the zero is the flight's next event:
+    returns its time with y there (the impact test of `examine` holds there), or −1
+    when the shortcut does not apply (y then undefined)."""
     k = int(res[STEP_K])
     flat = model.flat_ground
     j = contact_jet(y, flat, pts, k, acc)
@@ -293,9 +340,12 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     end = zero_bracket_end(j.gap, j.rate, j.accel, bounds.K, bounds.B)
     if not s + end < horizon:
         return -1.0
-    if not _others_safe_until(y, acc, model, pts, k, end, bounds.K, bounds.B, windowed):
-        return -1.0
+    safe = _others_safe_time(y, acc, model, pts, k, end, bounds.K, bounds.B, windowed, vnoise)
+    if not safe > step or (safe < end and safe < quadratic_taylor_root(j.gap, j.rate, j.accel)):
+        return -1.0  # (the Taylor root, an estimate of the zero: Newton would be in vain)
     x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, y)
+    if safe < end and x - s > safe:
+        return -1.0
     jr = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, model.gravity))
     graze = GRAZE_FACTOR * math.sqrt(2.0 * max(jr.accel, 0.0) * jr.noise)
     if jr.gap <= jr.noise and jr.rate < -max(vnoise, graze):
