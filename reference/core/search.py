@@ -43,6 +43,12 @@ STEP, STEP_K, HIT_DS, HIT_K, LAND_K = range(5)
 
 
 @hot
+def _safe_side_gap(gap, noise):
+    """A touching contact's gap bounded from the safe side: max(g, 0) + its roundoff."""
+    return max(gap, 0.0) + noise
+
+
+@hot
 def examine(y, acc, flat, pts, k, K, B, vnoise, res):
     """Examine contact k at state y: update res with its safe step, or record it as hit
     (touching and approaching faster than a graze) or landing (touching at rest,
@@ -59,7 +65,7 @@ def examine(y, acc, flat, pts, k, K, B, vnoise, res):
             return
         if j.rate <= vnoise and j.accel < 0:
             res[LAND_K] = k
-        g = max(g, 0.0) + j.noise  # touching, not approaching: bound from the safe side
+        g = _safe_side_gap(g, j.noise)  # touching, not approaching
     d = safe_step(g, j.rate, j.accel, K, B, res[STEP])
     if d < res[STEP]:
         res[STEP] = d
@@ -278,7 +284,7 @@ def _others_safe_time(y, acc, model, pts, k, end, K, B, windowed, vnoise):
     """How long every contact but k certainly stays above the ground, up to end: the
     least root of their lower bounds max(P2, P3) (`roots.safe_step`); a touching
     contact moving away faster than the rate noise counts from the safe side as
-    `examine` bounds it (gap max(g, 0) + roundoff), any other touching contact gives 0.
+    `examine` bounds it (`_safe_side_gap`), any other touching contact gives 0.
     With the window search only the vertices of window(end) are examined: the others
     are safe over [0, end] by P2 (`vertex_window`)."""
     n = pts.shape[0]
@@ -295,7 +301,7 @@ def _others_safe_time(y, acc, model, pts, k, end, K, B, windowed, vnoise):
         if g <= jt.noise:
             if not jt.rate > vnoise:
                 return 0.0
-            g = max(g, 0.0) + jt.noise
+            g = _safe_side_gap(g, jt.noise)
         t = min(t, safe_step(g, jt.rate, jt.accel, K, B, t))
     return t
 
