@@ -68,10 +68,10 @@ class Problem:
     def grow(self, max_samples: int) -> None:
         """Double the arrays the loop ran short of: impacts, phases and accumulation
         times with fewer than STEP_ROWS free rows (the loop's own test before every
-        step); otherwise the
-        samples (the only rows a step itself asks for), up to max_samples rows.  Growing
-        the large sample arrays only when they are what is short keeps runs with many
-        chatter completions from copying them again and again."""
+        step); otherwise the samples (the only rows a step itself asks for), up to
+        max_samples rows.  Growing the large sample arrays only when they are what is
+        short keeps runs with many chatter completions from copying them again and
+        again."""
         c = self.counts
         short = False
         for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES),

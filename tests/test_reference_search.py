@@ -272,7 +272,7 @@ def test_others_safe_time_ends_before_any_other_contact_reaches_the_ground():
         acc = flight_acceleration(fc, y, scene.gravity)
         bounds = flight_bounds(y, fc, model, pts, 10.0)
         end = 10.0
-        t = _others_safe_time(y, acc, model, pts, k, end, bounds.K, bounds.B, False,
+        t = _others_safe_time(y, acc, model, pts, k, end, 0.0, bounds.K, bounds.B, False,
                               rate_noise(y, 1.0))  # fmt: skip
         assert t > 0
         others = np.delete(np.arange(7), k)

@@ -280,13 +280,15 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
 
 
 @hot
-def _others_safe_time(y, acc, model, pts, k, end, K, B, windowed, vnoise):
+def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise):
     """How long every contact but k certainly stays above the ground, up to end: the
     least root of their lower bounds max(P2, P3) (`roots.safe_step`); a touching
     contact moving away faster than the rate noise counts from the safe side as
-    `examine` bounds it (`_safe_side_gap`), any other touching contact gives 0.
-    With the window search only the vertices of window(end) are examined: the others
-    are safe over [0, end] by P2 (`vertex_window`)."""
+    `examine` bounds it (`_safe_side_gap`), any other touching contact gives 0.  Once
+    that time is at most `floor` (where the caller has no use for it) it is returned
+    without examining the rest.  With the window search only the vertices of
+    window(end) are examined: the others are safe over [0, end] by P2
+    (`vertex_window`)."""
     n = pts.shape[0]
     first, half = 0, n // 2
     if windowed:
@@ -303,6 +305,8 @@ def _others_safe_time(y, acc, model, pts, k, end, K, B, windowed, vnoise):
                 return 0.0
             g = _safe_side_gap(g, jt.noise)
         t = min(t, safe_step(g, jt.rate, jt.accel, K, B, t))
+        if not t > floor:
+            return t
     return t
 
 
@@ -343,10 +347,11 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     j = contact_jet(y, flat, pts, k, acc)
     if j.gap <= j.noise:
         return -1.0
-    end = zero_bracket_end(j.gap, j.rate, j.accel, bounds.K, bounds.B)
+    K, B = bounds.K, bounds.B
+    end = zero_bracket_end(j.gap, j.rate, j.accel, K, B)
     if not s + end < horizon:
         return -1.0
-    safe = _others_safe_time(y, acc, model, pts, k, end, bounds.K, bounds.B, windowed, vnoise)
+    safe = _others_safe_time(y, acc, model, pts, k, end, step, K, B, windowed, vnoise)
     if not safe > step or (safe < end and safe < quadratic_taylor_root(j.gap, j.rate, j.accel)):
         return -1.0  # (the Taylor root, an estimate of the zero: Newton would be in vain)
     x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, y)
