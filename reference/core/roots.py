@@ -41,55 +41,75 @@ def _critical_points(c1, c2, c3):
 
 
 @hot
-def _monotone_root(c0, c1, c2, c3, lo, hi):
-    """A point below the root of the cubic on [lo, hi] (monotone there, positive at lo,
-    ≤ 0 at hi), within ROOT_REL_TOL of it: safeguarded Newton from lo (from the middle
-    when lo = 0), pushed a little past the root once its step is below the tolerance so
-    that the bracket closes."""
-    x = lo if lo > 0.0 else 0.5 * (lo + hi)
-    for _ in range(200):
-        f = _cubic_value(c0, c1, c2, c3, x)
-        if f > 0.0:
-            lo = x
-        else:
-            hi = x
-        tol = ROOT_REL_TOL * hi
-        if hi - lo <= tol:
+def _cubic_slopes(c1, c2, c3, x):
+    """The cubic's first and second derivatives at x."""
+    return c1 + x * (2.0 * c2 + 3.0 * c3 * x), 2.0 * c2 + 6.0 * c3 * x
+
+
+@hot
+def _past_root_bound(flo, d2lo, c3):
+    """A step h past the first root from a point where the cubic (c3 < 0) is flo > 0
+    and not rising, with second derivative d2lo there: the cubic is at most
+    flo + d2lo h²/2 + c3 h³ ≤ 0 once |c3| h³ ≥ 2 flo and |c3| h ≥ d2lo."""
+    return max((2.0 * flo / -c3) ** (1.0 / 3.0), d2lo / -c3)
+
+
+@hot
+def _monotone_root(c0, c1, c2, c3, lo, flo, hi, fhi):
+    """A point below the root of the cubic on [lo, hi] (decreasing there, flo = f(lo)
+    > 0, fhi = f(hi) ≤ 0; hi = inf: decreasing for ever, c3 < 0), within ROOT_REL_TOL
+    of it.
+
+    With c3 ≤ 0 the Taylor quadratic of the cubic at a point x is above the cubic to the
+    right of x and below it to the left (the remainder is c3 h³): its root from lo is
+    past the root (a new hi), its root from hi back toward lo short of it (a new lo).
+    Each estimate is taken from the end that moved last, so it lands on the other side,
+    third-order close; pushed a quarter of the tolerance further, so that the bracket
+    closes rather than one end creeping up on the root.  The midpoint when an estimate
+    falls outside the bracket (a Taylor quadratic without a root, roundoff)."""
+    from_lo = True
+    for _ in range(100):
+        if hi < math.inf and hi - lo <= ROOT_REL_TOL * hi:
             break
-        d = c1 + x * (2.0 * c2 + 3.0 * x * c3)
-        nxt = x - f / d if d != 0.0 else 0.5 * (lo + hi)
-        if abs(nxt - x) < 0.25 * tol:
-            nxt += math.copysign(0.25 * tol, nxt - x)
-        if not lo < nxt < hi:
-            nxt = 0.5 * (lo + hi)
-        x = nxt
+        if from_lo:
+            d1, d2 = _cubic_slopes(c1, c2, c3, lo)
+            x = lo + quadratic_taylor_root(flo, d1, d2)
+            x += 0.25 * ROOT_REL_TOL * x
+            if not x < math.inf and hi == math.inf:
+                x = lo + _past_root_bound(flo, d2, c3)
+        else:
+            d1, d2 = _cubic_slopes(c1, c2, c3, hi)
+            x = hi - quadratic_taylor_root(-fhi, d1, -d2) - 0.25 * ROOT_REL_TOL * hi
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+        f = _cubic_value(c0, c1, c2, c3, x)
+        from_lo = f > 0.0
+        if from_lo:
+            lo, flo = x, f
+        else:
+            hi, fhi = x, f
     return lo
 
 
 @hot
 def cubic_first_root(c0, c1, c2, c3, start=0.0):
-    """First positive root of c0 + c1 x + c2 x² + c3 x³ (c0 > 0, c3 ≤ 0), from below
-    within ROOT_REL_TOL; inf if there is none.  `start`: a point up to which the cubic is
-    known to stay positive.  The critical points split (start, ∞) into monotone pieces;
-    the first whose end value is ≤ 0 holds the root."""
+    """First positive root of c0 + c1 x + c2 x² + c3 x³ (c3 ≤ 0, positive on [0,
+    start]), from below within ROOT_REL_TOL; inf if there is none.  The critical points
+    split (start, ∞) into monotone pieces; the first whose end value is ≤ 0 holds the
+    root (`_monotone_root`), the last one when the cubic falls for ever after it."""
     m, cr0, cr1 = _critical_points(c1, c2, c3)
     lo = start
-    for i in range(m + 1):
-        if i < m:
-            hi = cr0 if i == 0 else cr1
-            if hi <= lo:
-                continue
-        else:
-            if not (c3 < 0 or (c3 == 0 and (c2 < 0 or (c2 == 0 and c1 < 0)))):
-                return math.inf
-            hi = max(lo, 1.0)
-            while _cubic_value(c0, c1, c2, c3, hi) > 0:
-                hi *= 2.0
-                if hi > 1e300:
-                    return math.inf
-        if _cubic_value(c0, c1, c2, c3, hi) <= 0.0:
-            return _monotone_root(c0, c1, c2, c3, lo, hi)
-        lo = hi
+    flo = _cubic_value(c0, c1, c2, c3, lo)
+    for i in range(m):
+        hi = cr0 if i == 0 else cr1
+        if hi <= lo:
+            continue
+        fhi = _cubic_value(c0, c1, c2, c3, hi)
+        if fhi <= 0.0:
+            return _monotone_root(c0, c1, c2, c3, lo, flo, hi, fhi)
+        lo, flo = hi, fhi
+    if c3 < 0.0 or (c3 == 0.0 and (c2 < 0.0 or (c2 == 0.0 and c1 < 0.0))):
+        return _monotone_root(c0, c1, c2, c3, lo, flo, math.inf, -math.inf)
     return math.inf
 
 
@@ -152,6 +172,8 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
     P3 is not solved: a value ≥ cap is returned."""
     if g <= 0.0:
         return 0.0
+    if cap < math.inf and g + cap * (g1 - 0.5 * K * cap) > 0.0:
+        return cap  # P2 (concave, positive at 0) positive at cap: its root is past cap
     d2 = quadratic_first_root(g, g1, K)
     if d2 >= cap:
         return d2
