@@ -115,13 +115,17 @@ def rim_depth_bound(y0, Lx, Ly, Lz, radius):
     depth a sin α, with the axis e3 precessing about L̂ (regular precession), so that
     e3_z(s) = c + A cos Ωs + S sin Ωs (`_height_terms`) stays within c ± √(A² + S²):
     sin α ≤ √(1 − m²), m the least |e3_z| over that range (0 if it holds 0).  Bounds
-    every vertex at once for the whole flight, however fast the body spins; a few ulps
-    of margin on the result."""
+    every vertex at once for the whole flight, however fast the body spins.  The range's
+    ends carry a few ulps of roundoff, so m is first lowered by BOUND_ULPS ulps: near
+    flat, where e3_z rounds to 1, that keeps a depth of at least a √(2 BOUND_ULPS ε) ≈
+    8e-8 a (without it a tilt of 1e-9 spinning about its axis gave 4e-15 a, less than
+    its lowest vertex's 1e-9 a); a few ulps more on the result."""
     e3x, e3y, e3z = body_axis(y0)
     c, A, S = _height_terms(e3x, e3y, e3z, Lx, Ly, Lz)
     R = math.sqrt(A * A + S * S)
     lo, hi = c - R, c + R
     m = 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
+    m = max(m - BOUND_ULPS * EPS, 0.0)
     s_max = math.sqrt(max(1.0 - m * m, 0.0))
     return radius * min(s_max + BOUND_ULPS * EPS, 1.0)
 
