@@ -21,17 +21,25 @@ from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTO
 
 @hot
 def vertex_lever(y, px, py):
+    """r = R p of the body point p = (px, py, 0) at state y (`lever_of_columns`)."""
+    return lever_of_columns(rotation_columns_xy(y), px, py)
+
+
+@hot
+def lever_of_columns(cols, px, py):
     """r = R p of the body point p = (px, py, 0): its position from the centre of mass in
-    the world frame (r_z from the small quaternion components: tilts keep their digits)."""
-    R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y)
+    the world frame, from R's first two columns (`rotation.rotation_columns_xy`: r_z
+    from the small quaternion components, tilts keep their digits)."""
+    R00, R01, R10, R11, R20, R21 = cols
     return R00 * px + R01 * py, R10 * px + R11 * py, R20 * px + R21 * py
 
 
 @hot
-def vertex_frame(y, px, py):
-    """Frame of the body point (px, py, 0) over flat ground: gap z + r_z, normal e_z,
-    lever r, roundoff GAP_NOISE_ULPS ε (|z| + |r_z|)."""
-    rx, ry, rz = vertex_lever(y, px, py)
+def vertex_frame(y, cols, px, py):
+    """Frame of the body point (px, py, 0) over flat ground (cols: R's first two columns
+    at state y): gap z + r_z, normal e_z, lever r, roundoff GAP_NOISE_ULPS ε (|z| +
+    |r_z|)."""
+    rx, ry, rz = lever_of_columns(cols, px, py)
     return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[2], rz))
 
 
@@ -57,7 +65,7 @@ def bump_frame(y, bx, by, bz):
 def contact_frame(y, flat, pts, k):
     """Gap, normal, lever and gap roundoff of contact k at state y."""
     if flat:
-        return vertex_frame(y, pts[k, 0], pts[k, 1])
+        return vertex_frame(y, rotation_columns_xy(y), pts[k, 0], pts[k, 1])
     return bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
@@ -123,7 +131,7 @@ def normal_acceleration(y, f, acc, flat, pts, k):
 def point_jet(y, px, py, acc):
     """Gap, rate, acceleration and roundoff of the body point (px, py, 0) over flat
     ground."""
-    f = vertex_frame(y, px, py)
+    f = vertex_frame(y, rotation_columns_xy(y), px, py)
     return Jet(f.gap, normal_velocity(y, f, True), vertex_normal_acceleration(y, f, acc), f.noise)
 
 

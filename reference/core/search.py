@@ -17,11 +17,21 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 
 import math
 
-from .contacts import contact_jet, rate_noise, reached_together, rim_jet, time_resolution
+from .contacts import (
+    contact_jet,
+    normal_velocity,
+    rate_noise,
+    reached_together,
+    rim_jet,
+    time_resolution,
+    vertex_frame,
+    vertex_normal_acceleration,
+)
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
-from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent
+from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent, Jet
 from .roots import quadratic_first_root, quadratic_taylor_root, safe_step, zero_bracket_end
+from .rotation import rotation_columns_xy
 from .tolerances import (
     BRACKET_ITERATIONS,
     CIRCLE_STEP_REL_TOL,
@@ -50,10 +60,30 @@ def _safe_side_gap(gap, noise):
 
 @hot
 def examine(y, acc, flat, pts, k, K, B, vnoise, res):
-    """Examine contact k at state y: update res with its safe step, or record it as hit
+    """Examine contact k at state y (`examine_jet`)."""
+    examine_jet(contact_jet(y, flat, pts, k, acc), k, K, B, vnoise, res)
+
+
+@hot
+def examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res):
+    """`examine` of vertex k over flat ground, R's columns (cols) formed once for all
+    the vertices of a step.  A vertex clear of the ground whose P2 is still positive
+    at the step found so far does not bind it (`roots.safe_step` returns that step):
+    passed over before its acceleration is formed."""
+    f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
+    rate = normal_velocity(y, f, True)
+    step = res[STEP]
+    if f.gap > f.noise and f.gap + step * (rate - 0.5 * K * step) > 0.0:
+        return
+    j = Jet(f.gap, rate, vertex_normal_acceleration(y, f, acc), f.noise)
+    examine_jet(j, k, K, B, vnoise, res)
+
+
+@hot
+def examine_jet(j, k, K, B, vnoise, res):
+    """Examine contact k with jet j: update res with its safe step, or record it as hit
     (touching and approaching faster than a graze) or landing (touching at rest,
     accelerating into the ground)."""
-    j = contact_jet(y, flat, pts, k, acc)
     g = j.gap
     if g <= j.noise:
         graze = GRAZE_FACTOR * math.sqrt(2.0 * max(j.accel, 0.0) * j.noise)
@@ -101,12 +131,13 @@ def examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius):
     their cubic (`roots.safe_step` solves it only when it would shorten the step)."""
     if count <= 0:
         return
+    cols = rotation_columns_xy(y)
     lead = likely_binding(y, jet, pts, n, K, first, count, radius, res[STEP])
-    examine(y, acc, True, pts, lead, K, B, vnoise, res)
+    examine_vertex(y, acc, cols, pts, lead, K, B, vnoise, res)
     for j in range(count):
         k = (first + j) % n
         if k != lead:
-            examine(y, acc, True, pts, k, K, B, vnoise, res)
+            examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res)
 
 
 @hot
