@@ -103,6 +103,12 @@ def examine_jet(j, k, K, B, vnoise, res):
 
 
 @hot
+def next_index(k, n):
+    """k + 1 mod n, for 0 ≤ k < n (a comparison, not a division)."""
+    return k + 1 if k + 1 < n else 0
+
+
+@hot
 def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
     """The vertex of first … first + count − 1 (mod n) whose P2 has the first root, if
     before best_d (the step found so far; else `first`): the likeliest to bind the step.
@@ -110,17 +116,17 @@ def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
     an ordering only, the examination is exact."""
     px, py, qx, qy, _, _ = jet
     inv_a = 1.0 / radius
-    best = first % n
-    for j in range(count):
-        k = (first + j) % n
+    best = k = first % n
+    for _ in range(count):
         cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
         g = max(y[2] + cx * px + cy * py, TINY)
         g1 = y[9] + cx * qx + cy * qy
-        if g + best_d * (g1 - 0.5 * K * best_d) > 0.0:
-            continue  # P2 (concave, positive at 0) still positive at the best root
-        d = quadratic_first_root(g, g1, K)
-        if d < best_d:
-            best, best_d = k, d
+        # (P2, concave and positive at 0, still positive at the best root: passed over)
+        if not g + best_d * (g1 - 0.5 * K * best_d) > 0.0:
+            d = quadratic_first_root(g, g1, K)
+            if d < best_d:
+                best, best_d = k, d
+        k = next_index(k, n)
     return best
 
 
@@ -134,10 +140,11 @@ def examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius):
     cols = rotation_columns_xy(y)
     lead = likely_binding(y, jet, pts, n, K, first, count, radius, res[STEP])
     examine_vertex(y, acc, cols, pts, lead, K, B, vnoise, res)
-    for j in range(count):
-        k = (first + j) % n
+    k = first % n
+    for _ in range(count):
         if k != lead:
             examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res)
+        k = next_index(k, n)
 
 
 @hot
@@ -325,8 +332,9 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
     t = end
-    for i in range(min(2 * half + 1, n)):
-        j = (first - half + i) % n
+    nxt = (first - half) % n
+    for _ in range(min(2 * half + 1, n)):
+        nxt, j = next_index(nxt, n), nxt
         if j == k:
             continue
         jt = contact_jet(y, model.flat_ground, pts, j, acc)
@@ -432,8 +440,9 @@ def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together)
     count = 1
     n = pts.shape[0]
     first, half = _candidates(y, model, pts, bounds, windowed)
-    for i in range(min(2 * half + 1, n)):
-        k = (first - half + i) % n
+    nxt = (first - half) % n
+    for _ in range(min(2 * half + 1, n)):
+        nxt, k = next_index(nxt, n), nxt
         if k == k0:
             continue
         j = contact_jet(y, flat, pts, k, acc)
@@ -451,8 +460,9 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     count = 0
     n = pts.shape[0]
     first, half = _candidates(y, model, pts, bounds, windowed)
-    for i in range(min(2 * half + 1, n)):
-        k = (first - half + i) % n
+    nxt = (first - half) % n
+    for _ in range(min(2 * half + 1, n)):
+        nxt, k = next_index(nxt, n), nxt
         j = contact_jet(y, model.flat_ground, pts, k, acc)
         if j.gap <= j.noise and j.rate <= vnoise and j.accel < 0:
             together[count] = k
