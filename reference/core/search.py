@@ -18,7 +18,9 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 import math
 
 from .contacts import (
+    contact_frame,
     contact_jet,
+    normal_acceleration,
     normal_velocity,
     rate_noise,
     reached_together,
@@ -70,8 +72,7 @@ def examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res):
     the vertices of a step.  A vertex clear of the ground whose P2 is still positive
     at the step found so far does not bind it (`roots.safe_step` returns that step):
     passed over before its acceleration is formed."""
-    f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
-    rate = normal_velocity(y, f, True)
+    f, rate = frame_and_rate(y, cols, True, pts, k)
     step = res[STEP]
     if f.gap > f.noise and f.gap + step * (rate - 0.5 * K * step) > 0.0:
         return
@@ -100,6 +101,17 @@ def examine_jet(j, k, K, B, vnoise, res):
     if d < res[STEP]:
         res[STEP] = d
         res[STEP_K] = k
+
+
+@hot
+def frame_and_rate(y, cols, flat, pts, k):
+    """Contact k's frame and normal velocity, without its acceleration (cols: R's
+    first two columns, for flat ground)."""
+    if flat:
+        f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
+    else:
+        f = contact_frame(y, flat, pts, k)
+    return f, normal_velocity(y, f, flat)
 
 
 @hot
@@ -332,18 +344,22 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
     t = end
+    flat = model.flat_ground
+    cols = rotation_columns_xy(y)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, j = next_index(nxt, n), nxt
         if j == k:
             continue
-        jt = contact_jet(y, model.flat_ground, pts, j, acc)
-        g = jt.gap
-        if g <= jt.noise:
-            if not jt.rate > vnoise:
+        f, rate = frame_and_rate(y, cols, flat, pts, j)
+        g = f.gap
+        if g <= f.noise:
+            if not rate > vnoise:
                 return 0.0
-            g = _safe_side_gap(g, jt.noise)
-        t = min(t, safe_step(g, jt.rate, jt.accel, K, B, t))
+            g = _safe_side_gap(g, f.noise)
+        if g + t * (rate - 0.5 * K * t) > 0.0:
+            continue  # P2 positive at t: safe_step would return t (its acceleration unneeded)
+        t = min(t, safe_step(g, rate, normal_acceleration(y, f, acc, flat, pts, j), K, B, t))
         if not t > floor:
             return t
     return t
@@ -430,12 +446,13 @@ def _candidates(y, model, pts, bounds, windowed):
 
 
 @hot
-def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together):
+def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
     """Contacts reached with k0 at state y (k0 first): approaching, with a zero within
     SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
     flat = model.flat_ground
-    j0 = contact_jet(y, flat, pts, k0, acc)
-    tres0 = time_resolution(j0.noise, j0.rate)
+    cols = rotation_columns_xy(y)
+    f0, rate0 = frame_and_rate(y, cols, flat, pts, k0)
+    tres0 = time_resolution(f0.noise, rate0)
     together[0] = k0
     count = 1
     n = pts.shape[0]
@@ -445,10 +462,10 @@ def collect_together(y, acc, model, pts, bounds, windowed, k0, vnoise, together)
         nxt, k = next_index(nxt, n), nxt
         if k == k0:
             continue
-        j = contact_jet(y, flat, pts, k, acc)
-        if j.rate >= -vnoise:
+        f, rate = frame_and_rate(y, cols, flat, pts, k)
+        if rate >= -vnoise:
             continue
-        if reached_together(j.gap, j.rate, j.noise, tres0):
+        if reached_together(f.gap, rate, f.noise, tres0):
             together[count] = k
             count += 1
     return count
@@ -515,8 +532,7 @@ def find_flight_event(
         if res[HIT_K] >= 0:
             k = int(res[HIT_K])
             s = polish_impact(y0, fc, g, model.flat_ground, pts, k, s + res[HIT_DS], y)
-            acc = flight_acceleration(fc, y, g)
-            m = collect_together(y, acc, model, pts, bounds, windowed, k, vnoise, together)
+            m = collect_together(y, model, pts, bounds, windowed, k, vnoise, together)
             return FlightEvent(EVENT_IMPACT, s, k, m, it)
         if res[LAND_K] >= 0:
             m = collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together)
@@ -527,8 +543,7 @@ def find_flight_event(
             )
             if s_root >= 0.0:
                 k = int(res[STEP_K])
-                acc = flight_acceleration(fc, y, g)
-                m = collect_together(y, acc, model, pts, bounds, windowed, k, vnoise, together)
+                m = collect_together(y, model, pts, bounds, windowed, k, vnoise, together)
                 return FlightEvent(EVENT_IMPACT, s_root, k, m, it)
             free_flight(y0, fc, g, s, y)
         step = max(step, MIN_STEP_REL * max(s, TINY))
