@@ -137,6 +137,13 @@ def cubic_positive_on(c0, c1, c2, c3, T):
 
 
 @hot
+def p2_positive_at(g, g1, K, x):
+    """Whether P2 = g + g1 δ − K δ²/2 (concave, g > 0) is still positive at δ = x: then
+    its first root is past x (no square root needed to tell)."""
+    return g + x * (g1 - 0.5 * K * x) > 0.0
+
+
+@hot
 def quadratic_first_root(g, g1, K):
     """First positive root of P2 = g + g1 δ − K δ²/2 (g > 0), in the cancellation-free
     form for g1's sign; inf if there is none."""
@@ -172,8 +179,8 @@ def safe_step(g, g1, g2, K, B, cap=math.inf):
     P3 is not solved: a value ≥ cap is returned."""
     if g <= 0.0:
         return 0.0
-    if cap < math.inf and g + cap * (g1 - 0.5 * K * cap) > 0.0:
-        return cap  # P2 (concave, positive at 0) positive at cap: its root is past cap
+    if cap < math.inf and p2_positive_at(g, g1, K, cap):
+        return cap  # P2's root is past cap
     d2 = quadratic_first_root(g, g1, K)
     if d2 >= cap:
         return d2

@@ -32,7 +32,13 @@ from .contacts import (
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent, Jet
-from .roots import quadratic_first_root, quadratic_taylor_root, safe_step, zero_bracket_end
+from .roots import (
+    p2_positive_at,
+    quadratic_first_root,
+    quadratic_taylor_root,
+    safe_step,
+    zero_bracket_end,
+)
 from .rotation import rotation_columns_xy
 from .tolerances import (
     BRACKET_ITERATIONS,
@@ -73,8 +79,7 @@ def examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res):
     at the step found so far does not bind it (`roots.safe_step` returns that step):
     passed over before its acceleration is formed."""
     f, rate = frame_and_rate(y, cols, True, pts, k)
-    step = res[STEP]
-    if f.gap > f.noise and f.gap + step * (rate - 0.5 * K * step) > 0.0:
+    if f.gap > f.noise and p2_positive_at(f.gap, rate, K, res[STEP]):
         return
     j = Jet(f.gap, rate, vertex_normal_acceleration(y, f, acc), f.noise)
     examine_jet(j, k, K, B, vnoise, res)
@@ -133,8 +138,7 @@ def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
         cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
         g = max(y[2] + cx * px + cy * py, TINY)
         g1 = y[9] + cx * qx + cy * qy
-        # (P2, concave and positive at 0, still positive at the best root: passed over)
-        if not g + best_d * (g1 - 0.5 * K * best_d) > 0.0:
+        if not p2_positive_at(g, g1, K, best_d):  # (else it cannot come first)
             d = quadratic_first_root(g, g1, K)
             if d < best_d:
                 best, best_d = k, d
@@ -357,8 +361,8 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
             if not rate > vnoise:
                 return 0.0
             g = _safe_side_gap(g, f.noise)
-        if g + t * (rate - 0.5 * K * t) > 0.0:
-            continue  # P2 positive at t: safe_step would return t (its acceleration unneeded)
+        if p2_positive_at(g, rate, K, t):
+            continue  # safe_step would return t: its acceleration is not needed
         t = min(t, safe_step(g, rate, normal_acceleration(y, f, acc, flat, pts, j), K, B, t))
         if not t > floor:
             return t
