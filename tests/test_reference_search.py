@@ -77,7 +77,9 @@ def _product_event(scene, y, window):
     return ev, sorted(together[: ev.n_together].tolist())
 
 
-@pytest.mark.parametrize("n,count", [(17, 40), (24, 40), (33, 40), (100, 40), (1000, 20), (10_000, 6)])
+@pytest.mark.parametrize(
+    "n,count", [(17, 40), (24, 40), (33, 40), (100, 40), (1000, 20), (10_000, 6)]
+)
 def test_large_n_window_search_finds_the_event_of_every_vertex_search(n, count):
     """For n > SMALL_N (16) the search examines only a window of vertices near the lowest
     direction and bounds the rest by the circle through them.  Against the same search
