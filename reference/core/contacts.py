@@ -128,6 +128,17 @@ def normal_acceleration(y, f, acc, flat, pts, k):
 
 
 @hot
+def frame_and_rate(y, cols, flat, pts, k):
+    """Contact k's frame and normal velocity, without its acceleration (cols: R's
+    first two columns, `rotation.rotation_columns_xy`, used for flat ground)."""
+    if flat:
+        f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
+    else:
+        f = contact_frame(y, flat, pts, k)
+    return f, normal_velocity(y, f, flat)
+
+
+@hot
 def point_jet(y, px, py, acc):
     """Gap, rate, acceleration and roundoff of the body point (px, py, 0) over flat
     ground."""

@@ -18,16 +18,13 @@ at once (`circle_step`).  The cost per step does not grow with n."""
 import math
 
 from .contacts import (
-    contact_frame,
     contact_jet,
+    frame_and_rate,
     normal_acceleration,
-    normal_velocity,
     rate_noise,
     reached_together,
     rim_jet,
     time_resolution,
-    vertex_frame,
-    vertex_normal_acceleration,
 )
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
@@ -67,29 +64,17 @@ def _safe_side_gap(gap, noise):
 
 
 @hot
-def examine(y, acc, flat, pts, k, K, B, vnoise, res):
-    """Examine contact k at state y (`examine_jet`)."""
-    examine_jet(contact_jet(y, flat, pts, k, acc), k, K, B, vnoise, res)
-
-
-@hot
-def examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res):
-    """`examine` of vertex k over flat ground, R's columns (cols) formed once for all
-    the vertices of a step.  A vertex clear of the ground whose P2 is still positive
-    at the step found so far does not bind it (`roots.safe_step` returns that step):
-    passed over before its acceleration is formed."""
-    f, rate = frame_and_rate(y, cols, True, pts, k)
+def examine(y, acc, cols, flat, pts, k, K, B, vnoise, res):
+    """Examine contact k at state y (cols: R's first two columns, formed once for all
+    the contacts of a step): update res with its safe step, or record it as hit
+    (touching and approaching faster than a graze) or landing (touching at rest,
+    accelerating into the ground).  A contact clear of the ground whose P2 is still
+    positive at the step found so far does not bind it (`roots.safe_step` would return
+    that step): passed over before its acceleration is formed."""
+    f, rate = frame_and_rate(y, cols, flat, pts, k)
     if f.gap > f.noise and p2_positive_at(f.gap, rate, K, res[STEP]):
         return
-    j = Jet(f.gap, rate, vertex_normal_acceleration(y, f, acc), f.noise)
-    examine_jet(j, k, K, B, vnoise, res)
-
-
-@hot
-def examine_jet(j, k, K, B, vnoise, res):
-    """Examine contact k with jet j: update res with its safe step, or record it as hit
-    (touching and approaching faster than a graze) or landing (touching at rest,
-    accelerating into the ground)."""
+    j = Jet(f.gap, rate, normal_acceleration(y, f, acc, flat, pts, k), f.noise)
     g = j.gap
     if g <= j.noise:
         graze = GRAZE_FACTOR * math.sqrt(2.0 * max(j.accel, 0.0) * j.noise)
@@ -106,17 +91,6 @@ def examine_jet(j, k, K, B, vnoise, res):
     if d < res[STEP]:
         res[STEP] = d
         res[STEP_K] = k
-
-
-@hot
-def frame_and_rate(y, cols, flat, pts, k):
-    """Contact k's frame and normal velocity, without its acceleration (cols: R's
-    first two columns, for flat ground)."""
-    if flat:
-        f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
-    else:
-        f = contact_frame(y, flat, pts, k)
-    return f, normal_velocity(y, f, flat)
 
 
 @hot
@@ -155,11 +129,11 @@ def examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius):
         return
     cols = rotation_columns_xy(y)
     lead = likely_binding(y, jet, pts, n, K, first, count, radius, res[STEP])
-    examine_vertex(y, acc, cols, pts, lead, K, B, vnoise, res)
+    examine(y, acc, cols, True, pts, lead, K, B, vnoise, res)
     k = first % n
     for _ in range(count):
         if k != lead:
-            examine_vertex(y, acc, cols, pts, k, K, B, vnoise, res)
+            examine(y, acc, cols, True, pts, k, K, B, vnoise, res)
         k = next_index(k, n)
 
 
@@ -312,8 +286,9 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
         -1.0,
     )
     if not model.flat_ground:
+        cols = rotation_columns_xy(y)  # (unused by the bumps' frames)
         for k in range(n):
-            examine(y, acc, False, pts, k, K, B, vnoise, res)
+            examine(y, acc, cols, False, pts, k, K, B, vnoise, res)
         return res[STEP], last_dlt
     jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
     if not windowed:
