@@ -106,6 +106,7 @@ def model_record(scene: Scene) -> np.ndarray:
     )
     rec["flat_ground"] = flat
     rec["n_contacts"] = scene.n_contacts
+    rec["sag"] = 1.0 - math.cos(math.pi / scene.body.n)
     rec["all_down"] = 2 if flat and scene.body.n == 2 else 3
     return rec
 

@@ -84,6 +84,9 @@ def generated_scenes():
     y[2] = np.sin(0.02) + 0.01
     y[9:13] = [-0.1, 0.0, 0.3, 20.0]
     yield "n4-spin", make_scene(n=4, gamma=0.5, state=y, t_end=2.0), None
+    # elastic bouncing with flights long enough that the circle through the vertices
+    # bounds the steps far from the ground (`search.far_from_ground`)
+    yield "n16-spin-elastic", make_scene(n=16, gamma=1.0, rho=0.5, state=y, t_end=3.0), None
 
 
 def time_tolerance(impact, radius=1.0, rtol=1e-12):

@@ -229,8 +229,8 @@ def test_circle_step_is_within_its_tolerance_below_the_circle_bound_root(seed):
         fc = flight_constants(y, i1, i3)
         bounds = flight_bounds(y, fc, model, pts, 10.0)
         jet = rim_jet(y, flight_acceleration(fc, y, scene.gravity), 1.0)
-        step, f0, _ = circle_step(y, jet, scene.gravity, bounds.B)
-        if not f0 > 0:
+        step = circle_step(y, jet, scene.gravity, bounds.B)
+        if not y[2] - np.hypot(jet[0], jet[1]) > 0:  # F(0): the circle's lowest point
             continue
         hi = 1e-14
         while _circle_bound(hi, y, jet, scene.gravity, bounds.B) > 0:

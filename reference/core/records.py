@@ -46,6 +46,8 @@ MODEL = np.dtype(
         ("gamma", np.float64),  # Newton's restitution coefficient γ
         ("flat_ground", np.bool_),  # flat ground (contacts = vertices), or three bumps
         ("n_contacts", np.int64),
+        ("sag", np.float64),  # 1 − cos(π/n): how far a vertex sits above the circle's
+        # lowest point, per a sin α, when that point is midway between two vertices
         ("all_down", np.int64),  # contacts held together that end the motion
     ]
 )

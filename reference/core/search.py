@@ -8,12 +8,13 @@ and pressing into the ground (an activation: it starts to be held).  Contacts wh
 zeros are within their time resolution of the first one's are reached together
 (`collect_together`): the model cannot order them.
 
-Large polygons (n > SMALL_N) over flat ground examine only the vertices that can touch
-within the step: a vertex's gap, rate and acceleration are linear in its body-frame
-position a(cos θ, sin θ), so its quadratic bound over a step δ is a sinusoid in θ and
-only an angular window around the lowest direction can reach the ground within δ
-(`vertex_window`); far from the ground the circle through the vertices bounds them all
-at once (`circle_step`).  The cost per step does not grow with n."""
+Over flat ground, far from it, the circle through the vertices bounds them all at once
+(`circle_step`, `far_from_ground`), for any n.  Nearer, large polygons (n > SMALL_N)
+examine only the vertices that can touch within the step: a vertex's gap, rate and
+acceleration are linear in its body-frame position a(cos θ, sin θ), so its quadratic
+bound over a step δ is a sinusoid in θ and only an angular window around the lowest
+direction can reach the ground within δ (`vertex_window`).  The cost per step does not
+grow with n."""
 
 import math
 
@@ -174,6 +175,19 @@ def _circle_bracket(f0, vz, g, B, px, py, qx, qy, rn):
 
 
 @hot
+def far_from_ground(y, jet, model):
+    """Whether the circle through the vertices has its lowest point, z − |p| with
+    |p| = a sin α (`circle_step`), more than four sags above the ground (a sag,
+    a sin α (1 − cos π/n), is the most a vertex sits above that point): the circle's
+    step then bounds them all at the price of one root; nearer, the vertices are
+    examined."""
+    px, py = jet[0], jet[1]
+    pn = math.sqrt(px * px + py * py)
+    allowance = 4.0 * pn * model.sag + 64.0 * EPS * (abs(y[2]) + model.radius)
+    return y[2] - pn > allowance
+
+
+@hot
 def circle_step(y, jet, g, B):
     """A step safe for every vertex at once, from the circle through them.
 
@@ -182,15 +196,14 @@ def circle_step(y, jet, g, B):
     rate and acceleration of the body points (a, 0), (0, a) less the centre's.  Over
     |c| = 1, P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ²|r|/2, concave on δ ≥ 0, so its first
     root is bracketed (`_circle_bracket`, else by doubling) and closed from below by
-    chords and from above by Newton steps.  Returns (the root from below within
-    CIRCLE_STEP_REL_TOL, F(0) = z − |p|, |p| = a sin α)."""
+    chords and from above by Newton steps.  Returns the root from below within
+    CIRCLE_STEP_REL_TOL."""
     z, vz = y[2], y[9]
     px, py, qx, qy, rx, ry = jet
     rn = math.sqrt(rx * rx + ry * ry)
-    pn = math.sqrt(px * px + py * py)
-    f0 = z - pn
+    f0 = z - math.sqrt(px * px + py * py)
     if f0 <= 0.0:
-        return 0.0, f0, pn
+        return 0.0
     lo, flo = 0.0, f0
     hi = _circle_bracket(f0, vz, g, B, px, py, qx, qy, rn)
     for _ in range(2000):
@@ -215,7 +228,7 @@ def circle_step(y, jet, g, B):
                     hi, fhi = x, fx
                     if x == chord:
                         push += 1
-    return lo, f0, pn
+    return lo
 
 
 @hot
@@ -291,17 +304,13 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
             examine(y, acc, cols, False, pts, k, K, B, vnoise, res)
         return res[STEP], last_dlt
     jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
+    rim = rim_step(y, model.gravity, bounds.depth, model.radius)
+    if far_from_ground(y, jet, model):
+        return max(circle_step(y, jet, model.gravity, B), rim), last_dlt
     if not windowed:
         examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
-        return max(res[STEP], rim_step(y, model.gravity, bounds.depth, model.radius)), last_dlt
-    # far from the ground the circle through the vertices gives the step at once; within
-    # a few sags (a sin α (1 − cos π/n): the most a vertex sits above the circle's lowest
-    # point) of it, the vertices near the lowest direction are examined
-    d_c, f0, pn = circle_step(y, jet, model.gravity, B)
-    d_c = max(d_c, rim_step(y, model.gravity, bounds.depth, model.radius))
-    sag = 4.0 * pn * (1.0 - math.cos(math.pi / n)) + 64.0 * EPS * (abs(y[2]) + model.radius)
-    if f0 > sag:
-        return d_c, last_dlt
+        return max(res[STEP], rim), last_dlt
+    d_c = max(circle_step(y, jet, model.gravity, B), rim)
     cap = near_vertices_step(y, acc, jet, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
     if cap < math.inf:
         last_dlt = cap
