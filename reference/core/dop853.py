@@ -54,19 +54,28 @@ def dop853_step(y, f0, h, model, pts, idx, m, work, K, y_new, tmp):
     number of right-hand-side evaluations."""
     copy_into(K[0], f0)
     for s in range(1, N_STAGES):
-        for c in range(13):
-            acc = 0.0
-            for j in range(s):
-                acc += DOP_A[s, j] * K[j, c]
-            tmp[c] = y[c] + h * acc
+        stage_state(y, h, DOP_A[s], K, s, tmp)
         held_rhs(tmp, model, pts, idx, m, work, K[s])
-    for c in range(13):
-        acc = 0.0
-        for j in range(N_STAGES):
-            acc += DOP_B[j] * K[j, c]
-        y_new[c] = y[c] + h * acc
+    stage_state(y, h, DOP_B, K, N_STAGES, y_new)
     held_rhs(y_new, model, pts, idx, m, work, K[N_STAGES])
     return N_STAGES
+
+
+@hot
+def stage_state(y, h, weights, K, s, out):
+    """out = y + h Σ_{j<s} weights[j] K[j]: a Runge–Kutta stage's state.  The sum runs
+    over stages j in order, row by row (13 contiguous components at a time, zero
+    weights skipped): for each component the same additions in the same order as a
+    column-wise sum, so the same bits, at a fraction of the time."""
+    for c in range(13):
+        out[c] = 0.0
+    for j in range(s):
+        w = weights[j]
+        if w != 0.0:
+            for c in range(13):
+                out[c] += w * K[j, c]
+    for c in range(13):
+        out[c] = y[c] + h * out[c]
 
 
 @hot
@@ -128,11 +137,7 @@ def dense_output(y, y_new, h, model, pts, idx, m, work, st):
     K, F = st.K, st.F
     for s in range(N_STAGES_EXTRA):
         row = N_STAGES + 1 + s
-        for c in range(13):
-            acc = 0.0
-            for j in range(row):
-                acc += DOP_A_EXTRA[s, j] * K[j, c]
-            st.tmp[c] = y[c] + h * acc
+        stage_state(y, h, DOP_A_EXTRA[s], K, row, st.tmp)
         held_rhs(st.tmp, model, pts, idx, m, work, K[row])
     for c in range(13):
         dy = y_new[c] - y[c]
