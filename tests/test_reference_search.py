@@ -306,3 +306,47 @@ def test_a_polygon_rolling_down_its_vertices_finds_each_impact_in_the_first_sear
     full = simulate(scene, options=ReferenceOptions(window_search=False))
     for a, b in zip(traj.impacts[:20], full.impacts[:20], strict=True):  # then chaos
         assert a.contact == b.contact and abs((a.t - b.t) + (a.t_lo - b.t_lo)) <= 1e-14
+
+
+def test_bracketed_newton_stops_at_the_zero_instead_of_alternating_between_its_ends(
+    monkeypatch,
+):
+    """Near a zero the computed gap is roundoff: on grazing-contact's flights a Newton
+    step from one end of the bracket could land on the other and back, 60 evaluations
+    (the cap) between two times a few ulps apart.  A step onto a bracket end bisects
+    instead.  Each flight after an impact (its state the run's post-impact sample),
+    brackets of the next impact's zero drawn over decades on both sides: at most 16
+    evaluations (counted on the Python form of `search._newton_in_bracket`, with the
+    compiled flight), ending inside the bracket where the gap is within its roundoff."""
+    from reference.core import search
+    from reference.core.contacts import contact_jet
+    from reference.core.flight import flight_acceleration
+
+    scene = resolve_scene("grazing-contact")
+    traj = simulate(scene)
+    model, pts = core_model(scene)
+    i1, _, i3 = scene.body.inertia_diag
+    calls, compiled_flight = [], search.free_flight
+
+    def counted_flight(*args):
+        calls.append(args[3])
+        return compiled_flight(*args)
+
+    newton = search._newton_in_bracket.py_func
+    monkeypatch.setitem(newton.__globals__, "free_flight", counted_flight)
+    rng = np.random.default_rng(0)
+    for before, e in zip(traj.impacts[:-1], traj.impacts[1:], strict=True):
+        i = np.flatnonzero(traj.t == before.t)[-1]  # the state just after `before`
+        y0 = np.concatenate([traj.position[i], traj.quaternion[i], traj.velocity[i],
+                             traj.angular_velocity[i]])  # fmt: skip
+        fc = flight_constants(y0, i1, i3)
+        s_hit = e.t - before.t
+        for _ in range(100):
+            lo = s_hit * (1 - 10 ** rng.uniform(-6, -1))
+            hi = s_hit * (1 + 10 ** rng.uniform(-8, -2))
+            calls.clear()
+            y = np.empty(13)
+            x = newton(y0, fc, scene.gravity, True, pts, e.contact, lo, hi, y)
+            jet = contact_jet(y, True, pts, e.contact, flight_acceleration(fc, y, scene.gravity))
+            assert len(calls) <= 16
+            assert lo < x < hi and abs(jet.gap) <= jet.noise

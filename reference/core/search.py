@@ -356,8 +356,12 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
 @hot
 def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
     """Contact k's single zero in [lo, hi] (gap > 0 at lo, ≤ 0 at hi, decreasing):
-    Newton steps kept inside the shrinking bracket (bisection otherwise), until a step
-    or the bracket is within two ulps; y ends at the zero, which is returned."""
+    Newton steps kept strictly inside the shrinking bracket (bisection otherwise), until
+    a step or the bracket is within two ulps; y ends at the zero, which is returned.
+    Near the zero the computed gap is roundoff, and a Newton step from one end of the
+    bracket can land on the other: evaluated again, it would send the next step back
+    (observed on the grazing-contact scene: 60 evaluations alternating between two times
+    6 ulps apart, the cap), so a step onto a bracket end bisects instead."""
     x = lo
     for _ in range(BRACKET_ITERATIONS):
         free_flight(y0, fc, gravity, x, y)
@@ -367,7 +371,7 @@ def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
         else:
             hi = x
         nxt = x - j.gap / j.rate if j.rate < 0.0 else 0.5 * (lo + hi)
-        if not lo <= nxt <= hi:
+        if not (lo < nxt < hi or nxt == x):  # (x is now lo or hi: nxt == x, converged)
             nxt = 0.5 * (lo + hi)
         if abs(nxt - x) <= 2.0 * EPS * abs(x) or hi - lo <= 2.0 * EPS * hi:
             return x  # converged to the last bits: y is the state at x
