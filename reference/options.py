@@ -20,7 +20,7 @@ class ReferenceOptions:
       is at most energy_floor × its initial value (18 decades by default; the exponent
       fit of E ≈ a (t_f − t)^c then has 13 after skipping its first 3 and last 2).
     max_samples: samples beyond this many are not recorded (the run goes on).
-    window_search: large polygons (n > 16) examine only the vertices near the ground at
+    window_search: large polygons (n > 19) examine only the vertices near the ground at
       each search step (False: every vertex; the same events, slower).
     work_budget: loop steps between returns to Python (progress display, Ctrl-C).
     """

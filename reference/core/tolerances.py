@@ -45,12 +45,14 @@ MAX_SEARCH_ITERATIONS = 100_000
 # ended as unable to advance (a guard: no known case reaches it).
 MAX_STALL_STEPS = 1000
 
-# Large polygons: for n > SMALL_N a search step examines only the vertices near the
-# lowest direction and WINDOW_MAX more on each side (reference.core.search).  Measured
-# (callgrind instructions per 20,000 elastic impacts, window against every vertex):
-# n = 12 +8 % (tumbling) / −1 % (fast spin), 16 +7 / −6 %, 24 −10 / −26 %, 32 −26 / −41 %;
-# polygon25-rolling −17 %.  Every vertex pays below the crossover, the window above it.
-SMALL_N = 16
+# Large polygons: for n > SMALL_N a search step near the ground examines only the
+# vertices near the lowest direction and WINDOW_MAX more on each side (far from it the
+# circle through the vertices bounds them all for any n; reference.core.search).
+# Measured (callgrind instructions per 20,000 elastic impacts, window against every
+# vertex, both with the circle far from the ground): n = 17 +6 % (fast spin) / +7 %
+# (tumbling), 18 +5 / +3 %, 19 +3 / +7 %, 20 −2 / −1 %, 24 −12 / −13 %.  Every vertex
+# pays below the crossover, the window above it.
+SMALL_N = 19
 # The circle step of large polygons (reference.core.search.circle_step) solves its
 # bound to this relative tolerance (from below: any value is safe; a looser one
 # shortens the step by as much and saves iterations of the solve).
