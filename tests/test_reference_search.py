@@ -324,7 +324,7 @@ def test_bracketed_newton_stops_at_the_zero_instead_of_alternating_between_its_e
 
     scene = resolve_scene("grazing-contact")
     traj = simulate(scene)
-    model, pts = core_model(scene)
+    _, pts = core_model(scene)
     i1, _, i3 = scene.body.inertia_diag
     calls, compiled_flight = [], search.free_flight
 
