@@ -48,6 +48,25 @@ def _held_state(two: bool):
     return y
 
 
+def _held_motion(model, pts, idx, m):
+    """f(t, y) of the held motion of contacts idx[:m], for solve_ivp."""
+    scratch = new_work()
+
+    def rhs(_t, y):
+        dy = np.empty(13)
+        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, scratch[0], dy)
+        return dy
+
+    return rhs
+
+
+def _rocking_pentagon():
+    """(model, pts, idx, m, y0, f) of a pentagon rocking on its held vertex 0."""
+    model, pts = core_model(make_scene(n=5, rho=0.45))
+    idx, m = np.array([0, 0, 0]), 1
+    return model, pts, idx, m, _held_state(False), _held_motion(model, pts, idx, m)
+
+
 @pytest.mark.parametrize("two", [False, True])
 def test_integration_is_scipys_dop853_step_for_step(two):
     scene = make_scene(n=5, rho=0.45)
@@ -57,12 +76,7 @@ def test_integration_is_scipys_dop853_step_for_step(two):
     y0 = _held_state(two)
     rtol = 1e-12
     atol = np.full(13, 1e-14)
-    scratch = new_work()
-
-    def rhs(_t, y):
-        dy = np.empty(13)
-        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, scratch[0], dy)
-        return dy
+    rhs = _held_motion(model, pts, idx, m)
 
     ref = solve_ivp(rhs, (0.0, 0.3), y0, method="DOP853", rtol=rtol, atol=atol)
     y = y0.copy()
@@ -80,17 +94,8 @@ def test_integration_is_scipys_dop853_step_for_step(two):
 def test_crossing_is_located_where_scipys_event_finds_it():
     """A free vertex of a pentagon rocking on one held vertex reaches the ground at the
     time scipy's solve_ivp event location gives (DOP853 dense output, brentq)."""
-    scene = make_scene(n=5, rho=0.45)
-    model, pts = core_model(scene)
-    idx, m = np.array([0, 0, 0]), 1
-    y0 = _held_state(False)
+    model, pts, idx, m, y0, rhs = _rocking_pentagon()
     rtol, atol = 1e-12, np.full(13, 1e-14)
-    scratch = new_work()
-
-    def rhs(_t, y):
-        dy = np.empty(13)
-        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, scratch[0], dy)
-        return dy
 
     def gap_event(k):
         def gap(_t, y):
@@ -106,10 +111,35 @@ def test_crossing_is_located_where_scipys_event_finds_it():
     y = y0.copy()
     out = empty_output()
     watch = np.arange(1, 5, dtype=np.int64)
+    ws = new_work()[0]
     r = integrate_held(
-        y, 2.0, model, pts, idx, m, rtol, atol, scratch[0], scratch[0], (0, 1.0, 0), out,
+        y, 2.0, model, pts, idx, m, rtol, atol, ws, ws, (0, 1.0, 0), out,
         (0.0, 0.0), 0, False, watch, 4,
     )  # fmt: skip
     assert r.status == INT_CROSSING
     assert abs(r.s - t_ref) < 1e-10
     assert abs(contact_frame(y, model["flat_ground"], pts, first[0]).gap) < 1e-12
+
+
+def test_heun_euler_step_is_the_motion_to_roundoff_on_a_short_step_and_rejects_a_long_one():
+    """heun_euler_step (order 2, Euler's difference as its estimate): over 1e-7 s of a
+    pentagon rocking on one held vertex it agrees with scipy's DOP853 at rtol 1e-13 to
+    roundoff and accepts at rtol 1e-12; its estimate grows as h² (×100 for 10× the
+    step) and rejects a step of 1e-3 s."""
+    from reference.core.dop853 import heun_euler_step
+
+    model, pts, idx, m, y0, rhs = _rocking_pentagon()
+    rtol, atol = 1e-12, np.full(13, 1e-14)
+
+    def step(h):
+        ws = new_work()[0]
+        f0, y1 = rhs(0.0, y0), np.empty(13)
+        err = heun_euler_step(y0, f0, h, rtol, atol, model, pts, idx, m, ws, ws, y1)
+        return err, y1
+
+    err, y1 = step(1e-7)
+    ref = solve_ivp(rhs, (0.0, 1e-7), y0, method="DOP853", rtol=1e-13, atol=1e-16)
+    assert err <= 1.0
+    np.testing.assert_allclose(y1, ref.y[:, -1], rtol=0, atol=4e-16)
+    assert step(1e-6)[0] / err == pytest.approx(100.0, rel=1e-3)
+    assert step(1e-3)[0] > 1.0

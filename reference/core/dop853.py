@@ -79,6 +79,25 @@ def stage_state(y, h, weights, K, s, out):
 
 
 @hot
+def heun_euler_step(y, f0, h, rtol, atol, model, pts, idx, m, work, st, y_new):
+    """One step of the Heun–Euler pair from (y, f0 = f(y)) into y_new: the explicit
+    trapezoid y + h/2 (f0 + f(y + h f0)), of order 2, with Euler's difference
+    h/2 (f(y + h f0) − f0) as its error estimate, measured as scipy measures DOP853's
+    (`_rms` against atol + rtol max(|y|, |y_new|)).  For steps so short that order 2
+    is exact to roundoff, where a DOP853 step's 12 evaluations buy nothing.  Returns
+    the error norm (≤ 1: accepted)."""
+    f1 = st.Ks[0]
+    for c in range(13):
+        st.ys[c] = y[c] + h * f0[c]
+    held_rhs(st.ys, model, pts, idx, m, work, f1)
+    for c in range(13):
+        y_new[c] = y[c] + 0.5 * h * (f0[c] + f1[c])
+        st.tmp[c] = 0.5 * h * (f1[c] - f0[c])
+        st.scale[c] = atol[c] + rtol * max(abs(y[c]), abs(y_new[c]))
+    return _rms(st.tmp, st.scale)
+
+
+@hot
 def _rms(v, scale):
     s = 0.0
     for i in range(v.shape[0]):

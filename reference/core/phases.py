@@ -21,10 +21,17 @@ from .contacts import (
     time_resolution,
     velocity_scale,
 )
-from .dop853 import INT_CROSSING, INT_FAILED, INT_LIFT_OFF, initial_step, integrate_held
+from .dop853 import (
+    INT_CROSSING,
+    INT_FAILED,
+    INT_LIFT_OFF,
+    heun_euler_step,
+    initial_step,
+    integrate_held,
+)
 from .events import activate, end_run, hold, resolve_impact
 from .flight import flight_constants, free_flight
-from .held import held_rhs, project_held
+from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
 from .jit import copy_into, hot
@@ -43,6 +50,7 @@ from .records import (
 from .search import flight_event
 from .tolerances import (
     CONTACT_GAP_RES,
+    HEUN_STEP_RATIO,
     MAX_SEARCH_ITERATIONS,
     TINY,
     WINDOW_MAX,
@@ -323,6 +331,8 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         if remaining > 0:
             end_run(state, STATUS_FAILED_NO_ADVANCE, state.active, state.n_active)
         return DONE
+    if _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near, remaining):
+        return DONE
     n_grid = grid_count(state.t_hi, state.t_lo, h, opts.sample_dt)
     if _needed(n_grid, out, opts):
         return NEEDS_ROWS
@@ -361,18 +371,68 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     if r.status == INT_CROSSING:  # an approaching contact reached the ground: its impact next
         stats.contact_chunks += 1
         return _cut_chunk(state, ws, r.s)
+    return _end_chunk(state, model, opts, stats, out, ws, h, r.h_next, remaining)
+
+
+@hot
+def _end_chunk(state, model, opts, stats, out, ws, h, h_next, remaining):
+    """Advance to the end of a chunk of length h (state ws.y_chunk, projected): its
+    forces at the start give the next chunk their trend, h_next its first step."""
+    y = state.y
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
     copy_into(y, ws.y_chunk)
-    for i in range(m):  # the forces at this chunk's start: the next one sees their trend
+    for i in range(state.n_active):  # the next chunk sees the forces' trend
         state.lam_prev[i] = ws.lam_chunk[i]
     state.h_prev = h
     state.has_trend = True
-    state.h_next = r.h_next
+    state.h_next = h_next
     if remaining - h <= 0:
         push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
         close_contact_phase(state, model, stats, out)
     return DONE
+
+
+@hot
+def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near, remaining):
+    """A chunk far shorter than the integrator's step (≤ HEUN_STEP_RATIO state.h_next)
+    in one step of the Heun–Euler pair (`dop853.heun_euler_step`), where a DOP853 step
+    would take 12 evaluations to be exact to roundoff: the chunk h, or with contacts
+    approaching within the gap resolution (cs.near) the first one's Taylor landing
+    time s = t_near/2 (`set_aside_approaching`), whose end, gap zero to roundoff, is
+    its impact's state.  Taken only if the pair accepts it at the chunk's tolerances,
+    no sample falls inside, no held force is negative at either end and no free
+    contact has crossed: else the DOP853 chunk, which locates those.  Returns True if
+    taken."""
+    s = 0.5 * t_near if n_near else h
+    if not (s <= h and s <= HEUN_STEP_RATIO * state.h_next):
+        return False
+    if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0:
+        return False
+    y, m = state.y, state.n_active
+    _set_tolerances(y, model, length_scale(y, model.radius), opts.contact_rtol, ws.atol)
+    err = heun_euler_step(y, ws.f, s, opts.contact_rtol, ws.atol, model, pts, state.active, m,
+                          ws, ws, ws.y_chunk)  # fmt: skip
+    held_forces(ws.y_chunk, model, pts, state.active, m, ws)
+    stats.contact_rhs_evals += 2
+    if not err <= 1.0 or _negative_force(ws.lam_chunk, m) or _negative_force(ws.lam, m):
+        return False
+    if _crossed(ws.y_chunk, state, model, pts, opts, cs, state.gap_res):
+        return False
+    if n_near:
+        stats.contact_chunks += 1
+        return _cut_chunk(state, ws, s) == DONE
+    project_held(ws.y_chunk, model, pts, state.active, m, ws)
+    return _end_chunk(state, model, opts, stats, out, ws, s, state.h_next, remaining) == DONE
+
+
+@hot
+def _negative_force(lam, m):
+    """Whether any of lam[:m] is negative."""
+    for i in range(m):
+        if lam[i] < 0.0:
+            return True
+    return False
 
 
 @hot

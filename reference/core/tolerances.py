@@ -85,6 +85,10 @@ HORIZON_ACC_FACTOR = 2.0
 LOCAL_TIME_FRACTION = 0.25
 ROTATION_TIME_FACTOR = 2.0
 FORCE_TREND_FACTOR = 1.5
+# A chunk at most HEUN_STEP_RATIO of the integrator's step is one Heun–Euler step
+# (phases._short_chunk): at rtol = 1e-12 DOP853 steps ~rtol^(1/9) ≈ 0.05 of the local
+# time scale T, and the pair's order-1 error estimate (s/T)² passes rtol for s ≲ 1e-6 T.
+HEUN_STEP_RATIO = 1e-5
 # Two Gauss–Newton passes bring held gaps back to roundoff after a chunk.
 PROJECTION_PASSES = 2
 # Lift-off and crossing times inside a chunk: located to LOCATE_XTOL × the chunk length
