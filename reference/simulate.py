@@ -23,6 +23,7 @@ from .core.records import (
     N_IMPACTS,
     N_PHASES,
     N_SAMPLES,
+    OVERFLOW,
     RETURN_DONE,
     RETURN_GROW,
 )
@@ -273,6 +274,11 @@ def _trajectory(
     scene: Scene, p: Problem, opts: ReferenceOptions, t_end: float, wall: float, compile_s: float
 ) -> Trajectory:
     c = p.counts
+    if c[OVERFLOW]:  # the loop checks for free rows before each step: a bug if reached
+        raise RuntimeError(
+            "reference: an output array ran out of rows during the run, so the trajectory "
+            "would be incomplete (internal error; please report it with the scene)"
+        )
     ns, ni, nph, nacc = (int(c[i]) for i in (N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS))
     state = p.state[0]
     status, message = status_message(state, p.options[0])

@@ -1,7 +1,8 @@
 """What the loop writes: samples, impacts, phases and chatter accumulation times, into
 arrays the caller owns (`Output`).  The loop checks before each step that the rows it
 may write are free (else it returns and the caller grows the arrays), so the overflow
-flag is only a guard.  Samples beyond `max_samples` are dropped."""
+flag is only a guard (`simulate` raises if it is ever set, rather than return a
+trajectory with rows missing).  Samples beyond `max_samples` are dropped."""
 
 from collections import namedtuple
 

@@ -401,13 +401,13 @@ def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near,
     approaching within the gap resolution (cs.near) the first one's Taylor landing
     time s = t_near/2 (`set_aside_approaching`), whose end, gap zero to roundoff, is
     its impact's state.  Taken only if the pair accepts it at the chunk's tolerances,
-    no sample falls inside, no held force is negative at either end and no free
-    contact has crossed: else the DOP853 chunk, which locates those.  Returns True if
-    taken."""
+    no sample falls inside (and rows for the run's last one are free), no held force is
+    negative at either end and no free contact has crossed: else the DOP853 chunk,
+    which locates those.  Returns True if taken."""
     s = 0.5 * t_near if n_near else h
     if not (s <= h and s <= HEUN_STEP_RATIO * state.h_next):
         return False
-    if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0:
+    if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0 or _needed(0, out, opts):
         return False
     y, m = state.y, state.n_active
     _set_tolerances(y, model, length_scale(y, model.radius), opts.contact_rtol, ws.atol)
