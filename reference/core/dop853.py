@@ -83,9 +83,10 @@ def heun_euler_step(y, f0, h, rtol, atol, model, pts, idx, m, work, st, y_new):
     """One step of the Heun–Euler pair from (y, f0 = f(y)) into y_new: the explicit
     trapezoid y + h/2 (f0 + f(y + h f0)), of order 2, with Euler's difference
     h/2 (f(y + h f0) − f0) as its error estimate, measured as scipy measures DOP853's
-    (`_rms` against atol + rtol max(|y|, |y_new|)).  For steps so short that order 2
-    is exact to roundoff, where a DOP853 step's 12 evaluations buy nothing.  Returns
-    the error norm (≤ 1: accepted)."""
+    (`_rms` against atol + rtol max(|y|, |y_new|)); when that passes, the order-2
+    result is more accurate still (local extrapolation, as DOP853's own).  For steps
+    far below the integrator's (`phases._short_chunk`), where a DOP853 step's 12
+    evaluations buy nothing.  Returns the error norm (≤ 1: accepted)."""
     f1 = st.Ks[0]
     for c in range(13):
         st.ys[c] = y[c] + h * f0[c]
