@@ -19,6 +19,7 @@ applied row by row (reference.core.arrays).
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,14 +32,18 @@ if TYPE_CHECKING:  # geometry depends on no other module of the package
 
 
 def contact_points(body: Body, ground: Ground) -> np.ndarray:
-    """(k, 3): body-frame vertices (flat ground) or world bump positions (three_point)."""
+    """(k, 3): body-frame vertices (flat ground) or world bump positions (three_point);
+    read-only, shared between calls with the same geometry."""
     if ground.kind == "flat":
-        ang = 2.0 * np.pi * np.arange(body.n) / body.n
-        r = body.radius
-    else:
-        ang = 2.0 * np.pi * np.arange(3) / 3
-        r = ground.bump_radius
-    pts = r * np.stack([np.cos(ang), np.sin(ang), np.zeros(len(ang))], axis=1)
+        return _regular_points(body.n, body.radius)
+    return _regular_points(3, ground.bump_radius)
+
+
+@functools.lru_cache(maxsize=64)
+def _regular_points(k: int, r: float) -> np.ndarray:
+    """(k, 3): r (cos 2πi/k, sin 2πi/k, 0), read-only."""
+    ang = 2.0 * np.pi * np.arange(k) / k
+    pts = r * np.stack([np.cos(ang), np.sin(ang), np.zeros(k)], axis=1)
     pts.setflags(write=False)
     return pts
 

@@ -226,48 +226,57 @@ _STATUS = {
 }
 
 
+# One-sentence messages per loop status: (state, options, t, sorted info contacts) →
+# text, formatted only for the status a run ends with.
+_MESSAGES = {
+    R.STATUS_T_END: lambda st, op, t, cs: f"reached t_end = {float(op['t_end']):g}",
+    R.STATUS_SINGULARITY: lambda st, op, t, cs: f"all contacts down at t = {t:.17g}",
+    R.STATUS_ENERGY_EXHAUSTED: lambda st, op, t, cs: (
+        f"energy exhausted to {float(op['energy_floor']):g} of its initial excess; "
+        "t_singularity extrapolated from the impact intervals"
+    ),
+    R.STATUS_TILT_FLOOR: lambda st, op, t, cs: (
+        f"inclination below {TILT_FLOOR:g} rad at t = {t:.17g}: the singularity for "
+        "double precision; t_singularity extrapolated from the impact intervals"
+    ),
+    R.STATUS_AT_REST: lambda st, op, t, cs: (
+        f"at rest on contacts {cs} at t = {t:.17g}: the motion has ended"
+    ),
+    R.STATUS_SIMULTANEOUS: lambda st, op, t, cs: (
+        f"contacts {cs} hit simultaneously at t = {t:.17g}"
+    ),
+    R.STATUS_PUSHED: lambda st, op, t, cs: (
+        f"impact at contact {int(st['info_contact'])} at t = {t:.17g} would push "
+        f"resting contact(s) {cs} into the ground (undecidable)"
+    ),
+    R.STATUS_MAX_IMPACTS: lambda st, op, t, cs: f"reached max_impacts = {int(op['max_impacts'])}",
+    R.STATUS_FAILED_NONFINITE: lambda st, op, t, cs: f"non-finite state at t = {t:.17g}",
+    R.STATUS_OFF_FACE: lambda st, op, t, cs: (
+        f"bump {cs[0] if cs else -1} meets the face's plane outside its rim "
+        f"at t = {t:.17g}: the body has left the bumps (outside the three_point model)"
+    ),
+    R.STATUS_FAILED_LCP: lambda st, op, t, cs: (
+        f"contact complementarity problem of contacts {cs} has no solution (at t = {t:.17g})"
+    ),
+    R.STATUS_FAILED_STUCK: lambda st, op, t, cs: f"event search did not converge (at t = {t:.17g})",
+    R.STATUS_FAILED_INTEGRATION: lambda st, op, t, cs: (
+        f"contact integration failed: step size below roundoff (at t = {t:.17g})"
+    ),
+    R.STATUS_FAILED_NO_ADVANCE: lambda st, op, t, cs: (
+        f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, or "
+        f"{MAX_STALL_STEPS} steps without progress, with contacts {cs} held)"
+    ),
+}
+
+
 def status_message(state: np.void, opts: np.void) -> tuple[Status, str]:
     """The Trajectory status and its one-sentence message for the loop's end state."""
     code = int(state["status"])
-    t = float(state["info_t"])
+    message = _MESSAGES.get(code)
+    if message is None:
+        return _STATUS.get(code, Status.FAILED), f"loop status {code}"
     contacts = sorted(int(c) for c in state["info"][: int(state["n_info"])])
-    messages = {
-        R.STATUS_T_END: f"reached t_end = {float(opts['t_end']):g}",
-        R.STATUS_SINGULARITY: f"all contacts down at t = {t:.17g}",
-        R.STATUS_ENERGY_EXHAUSTED: (
-            f"energy exhausted to {float(opts['energy_floor']):g} of its initial excess; "
-            "t_singularity extrapolated from the impact intervals"
-        ),
-        R.STATUS_TILT_FLOOR: (
-            f"inclination below {TILT_FLOOR:g} rad at t = {t:.17g}: the singularity for "
-            "double precision; t_singularity extrapolated from the impact intervals"
-        ),
-        R.STATUS_AT_REST: f"at rest on contacts {contacts} at t = {t:.17g}: the motion has ended",
-        R.STATUS_SIMULTANEOUS: f"contacts {contacts} hit simultaneously at t = {t:.17g}",
-        R.STATUS_PUSHED: (
-            f"impact at contact {int(state['info_contact'])} at t = {t:.17g} would push "
-            f"resting contact(s) {contacts} into the ground (undecidable)"
-        ),
-        R.STATUS_MAX_IMPACTS: f"reached max_impacts = {int(opts['max_impacts'])}",
-        R.STATUS_FAILED_NONFINITE: f"non-finite state at t = {t:.17g}",
-        R.STATUS_OFF_FACE: (
-            f"bump {contacts[0] if contacts else -1} meets the face's plane outside its rim "
-            f"at t = {t:.17g}: the body has left the bumps (outside the three_point model)"
-        ),
-        R.STATUS_FAILED_LCP: (
-            f"contact complementarity problem of contacts {contacts} has no solution "
-            f"(at t = {t:.17g})"
-        ),
-        R.STATUS_FAILED_STUCK: f"event search did not converge (at t = {t:.17g})",
-        R.STATUS_FAILED_INTEGRATION: (
-            f"contact integration failed: step size below roundoff (at t = {t:.17g})"
-        ),
-        R.STATUS_FAILED_NO_ADVANCE: (
-            f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, or "
-            f"{MAX_STALL_STEPS} steps without progress, with contacts {contacts} held)"
-        ),
-    }
-    return _STATUS.get(code, Status.FAILED), messages.get(code, f"loop status {code}")
+    return _STATUS.get(code, Status.FAILED), message(state, opts, float(state["info_t"]), contacts)
 
 
 def _trajectory(

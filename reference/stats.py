@@ -46,7 +46,7 @@ class RunStats(Mapping):
         cls, counters: np.void, wall: float, compile_s: float, n_impacts: int, **extra: Any
     ) -> RunStats:
         """From the core's counter record (reference.core.records.STATS)."""
-        c = {name: counters[name].item() for name in counters.dtype.names}
+        c = dict(zip(counters.dtype.names, counters.item(), strict=True))
         iters = int(c["search_iterations"])
         return cls(
             wall_time_s=wall,

@@ -41,3 +41,31 @@ def test_a_run_whose_output_ran_out_of_rows_raises_instead_of_returning_it_trunc
     problem.counts[OVERFLOW] = 1
     with pytest.raises(RuntimeError, match="ran out of rows"):
         _trajectory(scene, problem, opts, 0.1, 0.0, 0.0)
+
+
+def test_every_loop_status_ends_with_its_status_and_its_own_message():
+    """status_message formats only the ending status's sentence: each loop status of the
+    core maps to its Trajectory status with a message of its own; an unknown code is
+    `failed` with `loop status N`."""
+    from reference.core import records as R
+    from reference.simulate import _STATUS, initial_record, options_record, status_message
+    from reference.trajectory import Status
+
+    scene = resolve_scene("rod")
+    opts = options_record(scene, 1.0, ReferenceOptions())[0]
+    state = initial_record(np.zeros(13))[0]
+    state["info_t"], state["n_info"] = 0.125, 1
+    state["info"][0] = 2
+    codes = [v for k, v in vars(R).items() if k.startswith("STATUS_") and k != "STATUS_RUNNING"]
+    messages = set()
+    for code in codes:
+        state["status"] = code
+        status, message = status_message(state, opts)
+        assert status == _STATUS.get(code, Status.FAILED)
+        assert message and not message.startswith("loop status")
+        messages.add(message)
+    assert len(messages) == len(codes)
+    state["status"] = R.STATUS_SIMULTANEOUS
+    assert status_message(state, opts)[1] == "contacts [2] hit simultaneously at t = 0.125"
+    state["status"] = 999
+    assert status_message(state, opts) == (Status.FAILED, "loop status 999")
