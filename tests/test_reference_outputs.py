@@ -1,5 +1,6 @@
-"""The output arrays the compiled loop writes into: grown on request without changing
-the run, and never returned with rows missing."""
+"""What a run hands back: the output arrays the compiled loop writes into, grown on
+request without changing the run and never returned with rows missing, and the status
+and message it ends with."""
 
 from __future__ import annotations
 
