@@ -94,8 +94,16 @@ def heun_euler_step(y, f0, h, rtol, atol, model, pts, idx, m, work, st, y_new):
     for c in range(13):
         y_new[c] = y[c] + 0.5 * h * (f0[c] + f1[c])
         st.tmp[c] = 0.5 * h * (f1[c] - f0[c])
-        st.scale[c] = atol[c] + rtol * max(abs(y[c]), abs(y_new[c]))
+    step_scale(y, y_new, rtol, atol, st.scale)
     return _rms(st.tmp, st.scale)
+
+
+@hot
+def step_scale(y, y_new, rtol, atol, scale):
+    """scale = atol + rtol max(|y|, |y_new|): what a step's error is measured against
+    (scipy's rk.RungeKutta._step_impl)."""
+    for c in range(13):
+        scale[c] = atol[c] + max(abs(y[c]), abs(y_new[c])) * rtol
 
 
 @hot
@@ -291,8 +299,7 @@ def _accepted_step(y, f, t, s_end, h_abs, rtol, atol, model, pts, idx, m, work, 
         t_new = min(t + h_abs, s_end)
         h = t_new - t
         nfev += dop853_step(y, f, h, model, pts, idx, m, work, K, y_new, st.tmp)
-        for c in range(13):
-            scale[c] = atol[c] + max(abs(y[c]), abs(y_new[c])) * rtol
+        step_scale(y, y_new, rtol, atol, scale)
         err = error_norm(K, h, scale)
         if not math.isfinite(err):
             return t, 0.0, h_abs, nfev

@@ -396,8 +396,8 @@ def _end_chunk(state, model, opts, stats, out, ws, h, h_next, remaining):
 @hot
 def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near, remaining):
     """A chunk far shorter than the integrator's step (≤ HEUN_STEP_RATIO state.h_next)
-    in one step of the Heun–Euler pair (`dop853.heun_euler_step`), where a DOP853 step
-    would take 12 evaluations to be exact to roundoff: the chunk h, or with contacts
+    in one step of the Heun–Euler pair (`dop853.heun_euler_step`, 2 evaluations where a
+    DOP853 chunk spends 12 or more): the chunk h, or with contacts
     approaching within the gap resolution (cs.near) the first one's Taylor landing
     time s = t_near/2 (`set_aside_approaching`), whose end, gap zero to roundoff, is
     its impact's state.  Taken only if the pair accepts it at the chunk's tolerances,
