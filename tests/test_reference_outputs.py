@@ -4,12 +4,14 @@ and message it ends with."""
 
 from __future__ import annotations
 
+import importlib
+
 import numpy as np
 import pytest
 
 from harness.scenes import resolve_scene
 from reference import ReferenceOptions, compiled
-from reference.core.records import OVERFLOW
+from reference.core.records import N_IMPACTS, OVERFLOW
 from reference.simulate import _trajectory, make_problem, run_problem, simulate
 
 
@@ -24,6 +26,7 @@ def test_output_arrays_grown_during_the_run_give_the_run_that_had_room():
     for name in ("sample_t", "sample_y", "sample_e", "impacts", "phases", "accumulations"):
         arr = getattr(problem, name)
         setattr(problem, name, np.empty((8, *arr.shape[1:]), dtype=arr.dtype))
+    problem.full_rows = dict.fromkeys(problem.full_rows, 0)  # (double each time)
     run_problem(compiled.run_events(), problem, opts.max_samples)
     grown = _trajectory(scene, problem, opts, scene.run.t_end, 0.0, 0.0)
     assert len(grown.impacts) == len(whole.impacts) == 533
@@ -32,6 +35,26 @@ def test_output_arrays_grown_during_the_run_give_the_run_that_had_room():
     assert len(grown.t) == len(whole.t) > 2000
     np.testing.assert_array_equal(grown.t, whole.t)
     np.testing.assert_array_equal(grown.quaternion, whole.quaternion)
+
+
+def test_a_run_starts_with_rows_for_its_first_impacts_and_grows_once_to_max_impacts(
+    monkeypatch,
+):
+    """Outputs start with rows for FIRST_IMPACTS impacts (a short run never maps memory
+    for max_impacts); pentagon-bounce's 533 impacts, started with rows for 256, make
+    them grow once, straight to the rows for max_impacts; arrays with room are kept."""
+    simulate_module = importlib.import_module("reference.simulate")
+    monkeypatch.setattr(simulate_module, "FIRST_IMPACTS", 256)
+    scene = resolve_scene("pentagon-bounce")
+    opts = ReferenceOptions()
+    problem = make_problem(scene, scene.run.t_end, opts)
+    first = 256 + simulate_module.MIN_ROWS
+    assert len(problem.impacts) == first < 533
+    run_problem(compiled.run_events(), problem, opts.max_samples)
+    full = simulate_module.output_rows(scene.run.max_impacts, scene.run.t_end, opts)
+    assert len(problem.impacts) == full["impacts"] == scene.run.max_impacts + 64
+    assert len(problem.phases) == 2 * first > 534  # had room: kept
+    assert int(problem.counts[N_IMPACTS]) == 533
 
 
 def test_a_run_whose_output_ran_out_of_rows_raises_instead_of_returning_it_truncated():
