@@ -72,13 +72,15 @@ class Problem:
     phases: np.ndarray
     accumulations: np.ndarray
     counts: np.ndarray
+    contact_ints: np.ndarray  # (4, k) and (4, k): the loop's per-contact lists
+    contact_floats: np.ndarray  # (records.new_contact_arrays)
     full_rows: dict[str, int]  # output_rows for max_impacts: the first growth's sizes
 
     def arguments(self) -> tuple:
         return (
             self.model, self.points, self.options, self.state, self.counters, self.scratch,
             self.sample_t, self.sample_y, self.sample_e, self.impacts, self.phases,
-            self.accumulations, self.counts,
+            self.accumulations, self.counts, self.contact_ints, self.contact_floats,
         )  # fmt: skip
 
     def grow(self, max_samples: int) -> None:
@@ -153,9 +155,11 @@ def initial_record(y0: np.ndarray) -> np.ndarray:
 
 def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
     rows = output_rows(min(scene.run.max_impacts, FIRST_IMPACTS), t_end, opts)
+    points = np.array(contact_points(scene.body, scene.ground), dtype=float, order="C")
+    contact_ints, contact_floats = R.new_contact_arrays(len(points))
     return Problem(
         model=model_record(scene),
-        points=np.array(contact_points(scene.body, scene.ground), dtype=float, order="C"),
+        points=points,
         options=options_record(scene, t_end, opts),
         state=initial_record(initial_state(scene.initial)),
         counters=np.zeros(1, dtype=R.STATS),
@@ -167,6 +171,8 @@ def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
         phases=np.empty((rows["phases"], 6)),
         accumulations=np.empty(MIN_ROWS),
         counts=np.zeros(5, dtype=np.int64),
+        contact_ints=contact_ints,
+        contact_floats=contact_floats,
         full_rows=output_rows(scene.run.max_impacts, t_end, opts),
     )
 

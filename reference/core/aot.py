@@ -43,6 +43,8 @@ def signatures() -> dict:
             f2,
             f1,
             i1,
+            types.Array(types.int64, 2, "C"),
+            f2,
         ),  # fmt: skip
         "quaternion_product_rows": void(f2, f2, f2),
         "quaternion_exp_rows": void(f2, f2),

@@ -2,18 +2,24 @@
 
 `hot`: numba's njit without its reference-counting runtime (`_nrt=False`), for functions
 that allocate nothing and only read and write arrays they are given: every function
-on the event path (all of the loop below `run_events`, which allocates the contact
-lists of a call; numba compiles a callee with its caller's flags, so nothing under a
-hot function may allocate: scratch space lives in records.SCRATCH).  With the runtime,
+on the event path (all of the loop below `run_events`; numba compiles a callee with its
+caller's flags, so nothing under a hot function may allocate: scratch space lives in
+records.SCRATCH and the caller's per-contact arrays).  With the runtime,
 every array argument is reference-counted on each call (measured with perf on a bouncing
 triangle: NRT_incref/NRT_decref took 12 % of the run); without it, none is.  `_nrt` is
 numba's own switch for such code (numba.misc.mergesort uses it); a function that would
 allocate fails to compile, so a misuse cannot pass silently.
+
+`error_model="numpy"`: a float division by zero gives ±inf or nan, as in numpy, rather
+than a test before every division to raise ZeroDivisionError (Python's model, numba's
+default): the loop ends a run whose state is not finite with an explicit status
+(STATUS_FAILED_NONFINITE), and the tests cost ~2 % of a run's instructions (callgrind,
+five bench runs; results bit-identical on 17 check scenes).
 """
 
 from numba import njit
 
-hot = njit(cache=True, _nrt=False)
+hot = njit(cache=True, _nrt=False, error_model="numpy")
 
 
 @hot

@@ -55,7 +55,7 @@ from .records import (
     STEP_ROWS,
 )
 from .tolerances import MAX_PERIOD, MAX_STALL_STEPS, PERIOD_RATIO_TOL, TILT_FLOOR
-from .workspace import new_contact_lists
+from .workspace import contact_lists
 
 
 @hot
@@ -196,18 +196,19 @@ def loop_step(state, model, pts, opts, stats, out, ws, cs):
 @njit(cache=True)
 def run_events(
     model_rec, pts, opts_rec, state_rec, stats_rec, scratch_rec, sample_t, sample_y, sample_e,
-    impacts, phases, accumulations, counts,
+    impacts, phases, accumulations, counts, contact_ints, contact_floats,
 ):  # fmt: skip
     """Run the loop from the state in state_rec until the run ends (RETURN_DONE), an
     output array needs rows (RETURN_GROW) or work_budget steps are done
     (RETURN_YIELD).  Records are 1-element structured arrays (records.MODEL, OPTIONS,
     STATE, STATS, SCRATCH) that the caller owns, so that they outlive the call (a record
     does not keep its array alive); the output arrays and their row counts are those of
-    output.Output."""
+    output.Output; contact_ints and contact_floats hold the per-contact lists
+    (records.new_contact_arrays)."""
     model, opts, state, stats = model_rec[0], opts_rec[0], state_rec[0], stats_rec[0]
     out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, counts)
     ws = scratch_rec[0]
-    cs = new_contact_lists(pts.shape[0])
+    cs = contact_lists(contact_ints, contact_floats)
     for _ in range(opts.work_budget):
         if state.status != STATUS_RUNNING:
             return RETURN_DONE

@@ -170,6 +170,20 @@ SCRATCH = np.dtype(
 )
 
 # Columns of the impact rows the loop writes.
+# The loop's per-contact lists (workspace.ContactLists), rows of two (4, n) arrays the
+# caller allocates once per run (`new_contact_arrays`), so the loop allocates nothing.
+CONTACT_INT_ROWS = ("cand", "together", "hitting", "near")
+CONTACT_FLOAT_ROWS = ("gap", "rate", "accel", "noise")
+
+
+def new_contact_arrays(n):
+    """The int64 and float arrays of the per-contact lists of n contacts."""
+    return (
+        np.empty((len(CONTACT_INT_ROWS), n), dtype=np.int64),
+        np.empty((len(CONTACT_FLOAT_ROWS), n)),
+    )
+
+
 IMPACT_COLUMNS = ("t", "t_lo", "contact", "impulse", "v_normal_pre", "v_normal_post")
 # Columns of the phase rows: kind 0 = flight, 1 = contact (held contacts, −1 padded).
 PHASE_COLUMNS = ("t_start", "t_end", "kind", "contact0", "contact1", "contact2")

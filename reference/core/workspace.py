@@ -1,10 +1,10 @@
-"""Scratch space of one run of the event loop, allocated once: a records.SCRATCH record
-(fixed-size arrays: contact systems, DOP853 stages, event states and lists) and the
-per-contact lists below (their size is the number of contacts)."""
+"""Scratch space of one run of the event loop, allocated once by the caller: a
+records.SCRATCH record (fixed-size arrays: contact systems, DOP853 stages, event states
+and lists) and the per-contact lists below (their size is the number of contacts), rows
+of two arrays."""
 
 from collections import namedtuple
 
-import numpy as np
 from numba import njit
 
 ContactLists = namedtuple(
@@ -23,14 +23,10 @@ ContactLists = namedtuple(
 
 
 @njit(cache=True)
-def new_contact_lists(n):
+def contact_lists(ints, floats):
+    """ContactLists as rows of the caller's arrays (records.new_contact_arrays, rows in
+    the order of records.CONTACT_INT_ROWS and CONTACT_FLOAT_ROWS); compiled with numba's
+    reference counting, as the loop's entry point is, since the rows are views."""
     return ContactLists(
-        np.empty(n, dtype=np.int64),
-        np.empty(n),
-        np.empty(n),
-        np.empty(n),
-        np.empty(n),
-        np.empty(n, dtype=np.int64),
-        np.empty(n, dtype=np.int64),
-        np.empty(n, dtype=np.int64),
+        ints[0], floats[0], floats[1], floats[2], floats[3], ints[1], ints[2], ints[3]
     )
