@@ -59,29 +59,35 @@ def output_rows(impacts: int, t_end: float, opts: ReferenceOptions) -> dict[str,
 class Problem:
     """The records and arrays one run of the loop reads and writes."""
 
-    model: np.ndarray  # records.MODEL, 1 element
+    run: np.ndarray  # records.RUN, 1 element: model, options, state, counters, scratch
     points: np.ndarray  # (k, 3) contact points
-    options: np.ndarray  # records.OPTIONS
-    state: np.ndarray  # records.STATE
-    counters: np.ndarray  # records.STATS
-    scratch: np.ndarray  # records.SCRATCH: the loop's scratch space
     sample_t: np.ndarray
     sample_y: np.ndarray
     sample_e: np.ndarray
     impacts: np.ndarray
     phases: np.ndarray
     accumulations: np.ndarray
-    counts: np.ndarray
     contact_ints: np.ndarray  # (4, k) and (4, k): the loop's per-contact lists
     contact_floats: np.ndarray  # (records.new_contact_arrays)
     full_rows: dict[str, int]  # output_rows for max_impacts: the first growth's sizes
+    _arguments: tuple | None = None  # (kept until the arrays grow)
+
+    # The parts of the run record, as 1-element record arrays (views: writable)
+    model = property(lambda self: self.run["model"])
+    options = property(lambda self: self.run["options"])
+    state = property(lambda self: self.run["state"])
+    counters = property(lambda self: self.run["stats"])
+    scratch = property(lambda self: self.run["scratch"])
+    counts = property(lambda self: self.run["counts"][0])  # rows written: records.N_*
 
     def arguments(self) -> tuple:
-        return (
-            self.model, self.points, self.options, self.state, self.counters, self.scratch,
-            self.sample_t, self.sample_y, self.sample_e, self.impacts, self.phases,
-            self.accumulations, self.counts, self.contact_ints, self.contact_floats,
-        )  # fmt: skip
+        if self._arguments is None:
+            self._arguments = (
+                self.run, self.points, self.sample_t, self.sample_y, self.sample_e,
+                self.impacts, self.phases, self.accumulations, self.contact_ints,
+                self.contact_floats,
+            )  # fmt: skip
+        return self._arguments
 
     def grow(self, max_samples: int) -> None:
         """Grow the arrays the loop ran short of (to their full_rows, or twice their
@@ -90,6 +96,7 @@ class Problem:
         samples (the only rows a step itself asks for), up to max_samples rows.  Growing
         the large sample arrays only when they are what is short keeps runs with many
         chatter completions from copying them again and again."""
+        self._arguments = None
         c = self.counts
         short = False
         for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES),
@@ -157,20 +164,19 @@ def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
     rows = output_rows(min(scene.run.max_impacts, FIRST_IMPACTS), t_end, opts)
     points = np.array(contact_points(scene.body, scene.ground), dtype=float, order="C")
     contact_ints, contact_floats = R.new_contact_arrays(len(points))
+    run = np.zeros(1, dtype=R.RUN)
+    run["model"] = model_record(scene)
+    run["options"] = options_record(scene, t_end, opts)
+    run["state"] = initial_record(initial_state(scene.initial))
     return Problem(
-        model=model_record(scene),
+        run=run,
         points=points,
-        options=options_record(scene, t_end, opts),
-        state=initial_record(initial_state(scene.initial)),
-        counters=np.zeros(1, dtype=R.STATS),
-        scratch=np.zeros(1, dtype=R.SCRATCH),
         sample_t=np.empty((rows["samples"], 2)),
         sample_y=np.empty((rows["samples"], 13)),
         sample_e=np.empty((rows["samples"], 2)),
         impacts=np.empty((rows["impacts"], 6)),
         phases=np.empty((rows["phases"], 6)),
         accumulations=np.empty(MIN_ROWS),
-        counts=np.zeros(5, dtype=np.int64),
         contact_ints=contact_ints,
         contact_floats=contact_floats,
         full_rows=output_rows(scene.run.max_impacts, t_end, opts),

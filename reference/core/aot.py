@@ -26,26 +26,10 @@ def signatures() -> dict:
 
     f2 = types.Array(types.float64, 2, "C")
     f1 = types.Array(types.float64, 1, "C")
-    i1 = types.Array(types.int64, 1, "C")
+    i2 = types.Array(types.int64, 2, "C")
     f8, b1, void = types.float64, types.boolean, types.void
     return {
-        "run_events": types.int64(
-            rec(R.MODEL),
-            f2,
-            rec(R.OPTIONS),
-            rec(R.STATE),
-            rec(R.STATS),
-            rec(R.SCRATCH),
-            f2,
-            f2,
-            f2,
-            f2,
-            f2,
-            f1,
-            i1,
-            types.Array(types.int64, 2, "C"),
-            f2,
-        ),  # fmt: skip
+        "run_events": types.int64(rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2),
         "quaternion_product_rows": void(f2, f2, f2),
         "quaternion_exp_rows": void(f2, f2),
         "quaternion_log_rows": void(f2, f2),

@@ -195,19 +195,19 @@ def loop_step(state, model, pts, opts, stats, out, ws, cs):
 
 @njit(cache=True)
 def run_events(
-    model_rec, pts, opts_rec, state_rec, stats_rec, scratch_rec, sample_t, sample_y, sample_e,
-    impacts, phases, accumulations, counts, contact_ints, contact_floats,
+    run_rec, pts, sample_t, sample_y, sample_e, impacts, phases, accumulations,
+    contact_ints, contact_floats,
 ):  # fmt: skip
-    """Run the loop from the state in state_rec until the run ends (RETURN_DONE), an
-    output array needs rows (RETURN_GROW) or work_budget steps are done
-    (RETURN_YIELD).  Records are 1-element structured arrays (records.MODEL, OPTIONS,
-    STATE, STATS, SCRATCH) that the caller owns, so that they outlive the call (a record
-    does not keep its array alive); the output arrays and their row counts are those of
-    output.Output; contact_ints and contact_floats hold the per-contact lists
+    """Run the loop from the state in run_rec until the run ends (RETURN_DONE), an output
+    array needs rows (RETURN_GROW) or work_budget steps are done (RETURN_YIELD).
+    run_rec is a 1-element records.RUN array the caller owns (model, options, state,
+    counters, scratch and output row counts), so that it outlives the call (a record
+    does not keep its array alive); the output arrays are those of output.Output;
+    contact_ints and contact_floats hold the per-contact lists
     (records.new_contact_arrays)."""
-    model, opts, state, stats = model_rec[0], opts_rec[0], state_rec[0], stats_rec[0]
-    out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, counts)
-    ws = scratch_rec[0]
+    run = run_rec[0]
+    model, opts, state, stats, ws = run.model, run.options, run.state, run.stats, run.scratch
+    out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, run.counts)
     cs = contact_lists(contact_ints, contact_floats)
     for _ in range(opts.work_budget):
         if state.status != STATUS_RUNNING:

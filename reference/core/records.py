@@ -169,7 +169,21 @@ SCRATCH = np.dtype(
     ]
 )
 
-# Columns of the impact rows the loop writes.
+# Everything one run of the loop reads and writes but its output rows and per-contact
+# lists, in one record (one argument: each array passed from Python costs the call
+# ~40 ns): the model, options, state, counters, scratch space, and the row counts of
+# the output arrays (`counts[N_SAMPLES]` …).
+RUN = np.dtype(
+    [
+        ("model", MODEL),
+        ("options", OPTIONS),
+        ("state", STATE),
+        ("stats", STATS),
+        ("scratch", SCRATCH),
+        ("counts", np.int64, (5,)),
+    ]
+)
+
 # The loop's per-contact lists (workspace.ContactLists), rows of two (4, n) arrays the
 # caller allocates once per run (`new_contact_arrays`), so the loop allocates nothing.
 CONTACT_INT_ROWS = ("cand", "together", "hitting", "near")
@@ -184,6 +198,7 @@ def new_contact_arrays(n):
     )
 
 
+# Columns of the impact rows the loop writes.
 IMPACT_COLUMNS = ("t", "t_lo", "contact", "impulse", "v_normal_pre", "v_normal_post")
 # Columns of the phase rows: kind 0 = flight, 1 = contact (held contacts, −1 padded).
 PHASE_COLUMNS = ("t_start", "t_end", "kind", "contact0", "contact1", "contact2")
