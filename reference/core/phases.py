@@ -242,16 +242,24 @@ def _set_tolerances(y, model, scale_x, rtol, atol):
 
 
 @hot
-def _prepare_chunk(state, model, pts, opts, stats, ws, h):
-    """The chunk's tolerances (ws.atol, positions on the scale L) and its first step:
-    the previous chunk's h_next, or `_first_step`."""
-    y = state.y
+def _chunk_tolerances(y, model, opts, atol):
+    """A chunk's absolute tolerances (`_set_tolerances`, positions on the length scale L
+    of state y); returns L."""
     L = length_scale(y, model.radius)
+    _set_tolerances(y, model, L, opts.contact_rtol, atol)
+    return L
+
+
+@hot
+def _prepare_chunk(state, model, pts, opts, stats, ws, h):
+    """The chunk's tolerances (ws.atol, `_chunk_tolerances`) and its first step: the
+    previous chunk's h_next, or `_first_step`."""
     h_start = state.h_next
     if not h_start > 0.0:
+        L = length_scale(state.y, model.radius)
         h_start, nfev = _first_step(state, model, pts, opts, ws, h, L)
         stats.contact_rhs_evals += nfev
-    _set_tolerances(y, model, L, opts.contact_rtol, ws.atol)
+    _chunk_tolerances(state.y, model, opts, ws.atol)
     return h_start
 
 
@@ -410,7 +418,7 @@ def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near,
     if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0 or _needed(0, out, opts):
         return False
     y, m = state.y, state.n_active
-    _set_tolerances(y, model, length_scale(y, model.radius), opts.contact_rtol, ws.atol)
+    _chunk_tolerances(y, model, opts, ws.atol)
     err = heun_euler_step(y, ws.f, s, opts.contact_rtol, ws.atol, model, pts, state.active, m,
                           ws, ws, ws.y_chunk)  # fmt: skip
     held_forces(ws.y_chunk, model, pts, state.active, m, ws)
