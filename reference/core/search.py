@@ -8,8 +8,9 @@ and pressing into the ground (an activation: it starts to be held).  Contacts wh
 zeros are within their time resolution of the first one's are reached together
 (`collect_together`): the model cannot order them.
 
-Over flat ground, far from it, the circle through the vertices bounds them all at once
-(`circle_step`, `far_from_ground`), for any n.  Nearer, large polygons (n > SMALL_N)
+Over flat ground, far from it, the circle through the vertices bounds them all at once,
+for any n (reference.core.rim: a step from the rim's jet, then its lowest point followed
+in closed form down to two sags above the ground).  Nearer, large polygons (n > SMALL_N)
 examine only the vertices that can touch within the step: a vertex's gap, rate and
 acceleration are linear in its body-frame position a(cos θ, sin θ), so its quadratic
 bound over a step δ is a sinusoid in θ and only an angular window around the lowest
@@ -30,6 +31,7 @@ from .contacts import (
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent, Jet
+from .rim import circle_step, far_from_ground, rim_descent, rim_step
 from .roots import (
     p2_positive_at,
     quadratic_first_root,
@@ -40,7 +42,6 @@ from .roots import (
 from .rotation import rotation_columns_xy
 from .tolerances import (
     BRACKET_ITERATIONS,
-    CIRCLE_STEP_REL_TOL,
     EPS,
     GRAZE_FACTOR,
     MIN_STEP_REL,
@@ -145,122 +146,6 @@ def examine_window(y, acc, jet, pts, n, K, B, k0, half, vnoise, res, radius):
 
 
 @hot
-def _circle_F(x, z, vz, g, B, px, py, qx, qy, rn):
-    """F(x) = Z3(x) − |p + x q| − x²|r|/2 (`circle_step`)."""
-    ux, uy = px + x * qx, py + x * qy
-    return (
-        z + x * (vz - x * (0.5 * g + x * B / 6.0)) - math.sqrt(ux * ux + uy * uy) - 0.5 * x * x * rn
-    )
-
-
-@hot
-def _circle_slope(x, vz, g, B, px, py, qx, qy, rn):
-    """F′(x) (`_circle_F`)."""
-    ux, uy = px + x * qx, py + x * qy
-    un = math.sqrt(ux * ux + uy * uy)
-    d = vz - x * (g + 0.5 * x * B + rn)
-    return d - (ux * qx + uy * qy) / un if un > 0.0 else d
-
-
-@hot
-def _circle_bracket(f0, vz, g, B, px, py, qx, qy, rn):
-    """A first step past F's root: the root of F(0) + F′(0) h − (g + |r|) h²/2 ≥ F(h)
-    (Z3 below its Taylor quadratic, the norm below its tangent); without gravity and
-    rising, a guess for `circle_step` to double."""
-    d0 = _circle_slope(0.0, vz, g, B, px, py, qx, qy, rn)
-    h = quadratic_first_root(f0, d0, g + rn)
-    if not h < math.inf:
-        h = f0 / max(abs(d0) + math.sqrt(qx * qx + qy * qy), TINY)
-    return max(h, TINY)
-
-
-@hot
-def far_from_ground(y, jet, model):
-    """Whether the circle through the vertices has its lowest point, z − |p| with
-    |p| = a sin α (`circle_step`), more than four sags above the ground (a sag,
-    a sin α (1 − cos π/n), is the most a vertex sits above that point): the circle's
-    step then bounds them all at the price of one root; nearer, the vertices are
-    examined."""
-    px, py = jet[0], jet[1]
-    pn = math.sqrt(px * px + py * py)
-    allowance = 4.0 * pn * model.sag + 64.0 * EPS * (abs(y[2]) + model.radius)
-    return y[2] - pn > allowance
-
-
-@hot
-def circle_step(y, jet, g, B):
-    """A step safe for every vertex at once, from the circle through them.
-
-    A vertex's P3 bound is linear in its body direction c: P3_c(δ) = Z3(δ) + c·u3(δ),
-    Z3 = z + v_z δ − g δ²/2 − B δ³/6, u3 = p + δ q + δ² r/2 with p, q, r the height,
-    rate and acceleration of the body points (a, 0), (0, a) less the centre's.  Over
-    |c| = 1, P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ²|r|/2, concave on δ ≥ 0, so its first
-    root is bracketed (`_circle_bracket`, else by doubling) and closed from below by
-    chords and from above by Newton steps.  Returns the root from below within
-    CIRCLE_STEP_REL_TOL."""
-    z, vz = y[2], y[9]
-    px, py, qx, qy, rx, ry = jet
-    rn = math.sqrt(rx * rx + ry * ry)
-    f0 = z - math.sqrt(px * px + py * py)
-    if f0 <= 0.0:
-        return 0.0
-    lo, flo = 0.0, f0
-    hi = _circle_bracket(f0, vz, g, B, px, py, qx, qy, rn)
-    for _ in range(2000):
-        fhi = _circle_F(hi, z, vz, g, B, px, py, qx, qy, rn)
-        if fhi < 0.0:
-            break
-        lo, flo = hi, fhi
-        hi *= 2.0
-    push = 0
-    for _ in range(100):
-        if hi - lo <= CIRCLE_STEP_REL_TOL * hi:
-            break
-        d = _circle_slope(hi, vz, g, B, px, py, qx, qy, rn)
-        chord = _pushed_chord(lo, flo, hi, fhi, push)
-        newton = hi - fhi / d if d < 0.0 else -1.0
-        for x in (chord, newton):
-            if lo < x < hi:
-                fx = _circle_F(x, z, vz, g, B, px, py, qx, qy, rn)
-                if fx >= 0.0:
-                    lo, flo = x, fx
-                else:
-                    hi, fhi = x, fx
-                    if x == chord:
-                        push += 1
-    return lo
-
-
-@hot
-def _pushed_chord(lo, flo, hi, fhi, push):
-    """The chord's root on [lo, hi], kept half of CIRCLE_STEP_REL_TOL inside hi once a
-    chord has landed past the root (`push` ≥ 1) or rounds onto hi, and at most the
-    midpoint once that too has (push ≥ 2).  A chord lies below the concave F, so it
-    lands past the root only by roundoff: the root is then within roundoff of hi, where
-    chords alone would close the bracket an ulp at a time (observed: 100 evaluations
-    for a step of 1e-12 s); the midpoint, for F itself at roundoff level."""
-    chord = lo + (hi - lo) * flo / (flo - fhi)
-    if push >= 2:
-        return min(chord, 0.5 * (lo + hi))
-    if push == 1 or not chord < hi:
-        return min(chord, hi - 0.5 * CIRCLE_STEP_REL_TOL * hi)
-    return chord
-
-
-@hot
-def rim_step(y, gravity, depth, radius):
-    """A step safe for every vertex at once for the rest of the flight: no vertex is more
-    than `depth` (Bounds.depth) below the centre, whose height is a parabola, so none
-    touches before z + v_z δ − g δ²/2 = depth (`roots.quadratic_first_root`); 0 when
-    the centre is that low already.  Near the exact landing time of a spinning disk,
-    whose rim's lowest point does not move with the spin."""
-    h = y[2] - depth - 64.0 * EPS * (abs(y[2]) + radius)
-    if not h > 0.0:
-        return 0.0
-    return quadratic_first_root(h, y[9], gravity)
-
-
-@hot
 def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise, res):
     """Examine the vertices near the lowest direction into res and return the cap on the
     step they certify (inf when none is needed).  The touching/lowest vertices and
@@ -285,10 +170,11 @@ def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise
 
 
 @hot
-def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
+def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
     """One iteration's certified step (res holds hits and landings): every contact for
-    small n or the three-point ground, else the circle bound or the vertices near the
-    lowest direction.  Returns (step, last certified window step)."""
+    small n or the three-point ground, else, far from the ground, the circle through the
+    vertices (its step from the rim's jet, then `rim.rim_descent`), or the vertices near
+    the lowest direction.  Returns (step, last certified window step)."""
     n = pts.shape[0]
     K, B = bounds.K, bounds.B
     res[STEP], res[STEP_K], res[HIT_DS], res[HIT_K], res[LAND_K] = (
@@ -306,7 +192,8 @@ def _search_step(y, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, r
     jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
     rim = rim_step(y, model.gravity, bounds.depth, model.radius)
     if far_from_ground(y, jet, model):
-        return max(circle_step(y, jet, model.gravity, B), rim), last_dlt
+        d_c = max(circle_step(y, jet, model.gravity, B), rim)
+        return rim_descent(y, fc, model, bounds.depth, left, d_c), last_dlt
     if not windowed:
         examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
         return max(res[STEP], rim), last_dlt
@@ -519,7 +406,7 @@ def find_flight_event(
     for it in range(max_iter):
         acc = flight_acceleration(fc, y, g)
         step, last_dlt = _search_step(
-            y, acc, model, pts, bounds, vnoise, windowed, horizon - s, last_dlt, res
+            y, fc, acc, model, pts, bounds, vnoise, windowed, horizon - s, last_dlt, res
         )
         if res[HIT_K] >= 0:
             k = int(res[HIT_K])

@@ -53,11 +53,24 @@ MAX_STALL_STEPS = 1000
 # (tumbling), 18 +5 / +3 %, 19 +3 / +7 %, 20 −2 / −1 %, 24 −12 / −13 %.  Every vertex
 # pays below the crossover, the window above it.
 SMALL_N = 19
-# The circle step of large polygons (reference.core.search.circle_step) solves its
+# The circle step of large polygons (reference.core.rim.circle_root) solves its
 # bound to this relative tolerance (from below: any value is safe; a looser one
 # shortens the step by as much and saves iterations of the solve).
 CIRCLE_STEP_REL_TOL = 1e-2
+# The circle's lowest point is followed on its closed form (reference.core.rim.
+# rim_descent) for at most this many steps per search iteration: each shrinks its gap by
+# a factor near the ground (a lower bound's second-order loss), and costs a cosine, a
+# sine and a root rather than a state and the vertices near the ground.
+RIM_DESCENT_STEPS = 32
+# Newton steps locating where the circle's lowest point is two sags above the ground,
+# to within a sag (reference.core.rim.rim_target): at most RIM_NEWTON_STEPS (the point
+# only ends the descent: any time whose backward bound holds is safe).
+RIM_NEWTON_STEPS = 8
 WINDOW_MAX = 3
+# The lowest direction of a large polygon is found to within ANGLE_ERROR radians
+# (reference.core.window.direction_angle: a series whose remainder is below 2e-10) and
+# its vertex window widened by as much: one vertex of n = 1e6 is 6.3e-6 rad.
+ANGLE_ERROR = 1e-9
 # A search step may examine SEARCH_WINDOW_GROW vertices beyond those, else its step is
 # shortened by SEARCH_SHRINK until that suffices.
 SEARCH_WINDOW_GROW = 12
