@@ -50,7 +50,6 @@ from .tolerances import (
     SEARCH_SHRINK,
     SEARCH_WINDOW_GROW,
     TINY,
-    WINDOW_MAX,
 )
 from .window import use_window, vertex_window, window_offsets
 
@@ -148,13 +147,12 @@ def examine_window(y, acc, jet, pts, n, K, B, k0, half, vnoise, res, radius):
 @hot
 def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise, res):
     """Examine the vertices near the lowest direction into res and return the cap on the
-    step they certify (inf when none is needed).  The touching/lowest vertices and
-    WINDOW_MAX more on each side come first; the step δ they allow holds for the others
-    if those outside window(δ) are safe by P2 and those inside have been examined: at
-    most SEARCH_WINDOW_GROW more are, δ being shortened by SEARCH_SHRINK (from 4× the
-    last certified step) until that suffices."""
-    k0, h0 = vertex_window(y, radius, n, K, 0.0, 2)
-    h = min(h0 + WINDOW_MAX, n // 2)
+    step they certify (inf when none is needed).  The vertices that can be at the
+    ground now (window(0), two more on each side) come first; the step δ they allow
+    holds for the others if those outside window(δ) are safe by P2 and those inside have
+    been examined: at most SEARCH_WINDOW_GROW more are, δ being shortened by
+    SEARCH_SHRINK (from 4× the last certified step) until that suffices."""
+    k0, h = vertex_window(y, radius, n, K, 0.0, 2)
     examine_window(y, acc, jet, pts, n, K, B, k0, h, vnoise, res, radius)
     if res[HIT_K] >= 0 or res[LAND_K] >= 0 or 2 * h + 1 >= n:
         return math.inf
