@@ -16,7 +16,7 @@ from reference.simulate import _trajectory, make_problem, run_problem, simulate
 
 
 def test_output_arrays_grown_during_the_run_give_the_run_that_had_room():
-    """pentagon-bounce (533 impacts, contact phases, samples on a grid) started with 8
+    """pentagon-bounce (hundreds of impacts, contact phases, samples on a grid) started with 8
     rows of each output array: the loop asks for more again and again, and the result
     is the same, bit for bit, as the run sized for max_impacts."""
     scene = resolve_scene("pentagon-bounce")
@@ -29,7 +29,7 @@ def test_output_arrays_grown_during_the_run_give_the_run_that_had_room():
     problem.full_rows = dict.fromkeys(problem.full_rows, 0)  # (double each time)
     run_problem(compiled.run_events(), problem, opts.max_samples)
     grown = _trajectory(scene, problem, opts, scene.run.t_end, 0.0, 0.0)
-    assert len(grown.impacts) == len(whole.impacts) == 533
+    assert len(grown.impacts) == len(whole.impacts) > 500
     assert grown.impacts == list(whole.impacts)
     assert list(grown.phases) == list(whole.phases)
     assert len(grown.t) == len(whole.t) > 2000
@@ -41,20 +41,22 @@ def test_a_run_starts_with_rows_for_its_first_impacts_and_grows_once_to_max_impa
     monkeypatch,
 ):
     """Outputs start with rows for FIRST_IMPACTS impacts (a short run never maps memory
-    for max_impacts); pentagon-bounce's 533 impacts, started with rows for 256, make
-    them grow once, straight to the rows for max_impacts; arrays with room are kept."""
+    for max_impacts); pentagon-bounce's impacts (over 500), started with rows for 256,
+    make them grow once, straight to the rows for max_impacts; arrays with room are
+    kept."""
     simulate_module = importlib.import_module("reference.simulate")
     monkeypatch.setattr(simulate_module, "FIRST_IMPACTS", 256)
     scene = resolve_scene("pentagon-bounce")
     opts = ReferenceOptions()
+    whole = simulate(scene, options=opts)
     problem = make_problem(scene, scene.run.t_end, opts)
     first = 256 + simulate_module.MIN_ROWS
-    assert len(problem.impacts) == first < 533
+    assert len(problem.impacts) == first < 500 < len(whole.impacts)
     run_problem(compiled.run_events(), problem, opts.max_samples)
     full = simulate_module.output_rows(scene.run.max_impacts, scene.run.t_end, opts)
     assert len(problem.impacts) == full["impacts"] == scene.run.max_impacts + 64
-    assert len(problem.phases) == 2 * first > 534  # had room: kept
-    assert int(problem.counts[N_IMPACTS]) == 533
+    assert len(problem.phases) == 2 * first > len(whole.phases)  # had room: kept
+    assert int(problem.counts[N_IMPACTS]) == len(whole.impacts)
 
 
 def test_a_run_whose_output_ran_out_of_rows_raises_instead_of_returning_it_truncated():

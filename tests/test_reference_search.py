@@ -315,9 +315,10 @@ def test_bracketed_newton_stops_at_the_zero_instead_of_alternating_between_its_e
     step from one end of the bracket could land on the other and back, 60 evaluations
     (the cap) between two times a few ulps apart.  A step onto a bracket end bisects
     instead.  Each flight after an impact (its state the run's post-impact sample),
-    brackets of the next impact's zero drawn over decades on both sides: at most 16
-    evaluations (counted on the Python form of `search._newton_in_bracket`, with the
-    compiled flight), ending inside the bracket where the gap is within its roundoff."""
+    brackets of the next impact's zero drawn over decades on both sides, Newton started
+    at the bracket's safe end or anywhere inside: at most 16 evaluations (counted on the
+    Python form of `search._newton_in_bracket`, with the compiled flight), ending inside
+    the bracket where the gap is within its roundoff."""
     from reference.core import search
     from reference.core.contacts import contact_jet
     from reference.core.flight import flight_acceleration
@@ -346,7 +347,8 @@ def test_bracketed_newton_stops_at_the_zero_instead_of_alternating_between_its_e
             hi = s_hit * (1 + 10 ** rng.uniform(-8, -2))
             calls.clear()
             y = np.empty(13)
-            x = newton(y0, fc, scene.gravity, True, pts, e.contact, lo, hi, y)
+            x0 = lo if rng.uniform() < 0.5 else rng.uniform(lo, hi)  # (its start)
+            x = newton(y0, fc, scene.gravity, True, pts, e.contact, lo, hi, x0, y)
             jet = contact_jet(y, True, pts, e.contact, flight_acceleration(fc, y, scene.gravity))
             assert len(calls) <= 16
             assert lo < x < hi and abs(jet.gap) <= jet.noise

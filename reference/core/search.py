@@ -195,11 +195,10 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
     if not windowed:
         examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
         return max(res[STEP], rim), last_dlt
-    d_c = max(circle_step(y, jet, model.gravity, B), rim)
     cap = near_vertices_step(y, acc, jet, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
     if cap < math.inf:
         last_dlt = cap
-    return max(min(res[STEP], cap), d_c), last_dlt
+    return max(min(res[STEP], cap), rim), last_dlt
 
 
 @hot
@@ -239,15 +238,15 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
 
 
 @hot
-def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, y):
+def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, x, y):
     """Contact k's single zero in [lo, hi] (gap > 0 at lo, ≤ 0 at hi, decreasing):
-    Newton steps kept strictly inside the shrinking bracket (bisection otherwise), until
+    Newton steps from x in the bracket kept strictly inside the shrinking bracket
+    (bisection otherwise), until
     a step or the bracket is within two ulps; y ends at the zero, which is returned.
     Near the zero the computed gap is roundoff, and a Newton step from one end of the
     bracket can land on the other: evaluated again, it would send the next step back
     (observed on the grazing-contact scene: 60 evaluations alternating between two times
     6 ulps apart, the cap), so a step onto a bracket end bisects instead."""
-    x = lo
     for _ in range(BRACKET_ITERATIONS):
         free_flight(y0, fc, gravity, x, y)
         j = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, gravity))
@@ -284,9 +283,17 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     if not s + end < horizon:
         return -1.0
     safe = _others_safe_time(y, acc, model, pts, k, end, step, K, B, windowed, vnoise)
-    if not safe > step or (safe < end and safe < quadratic_taylor_root(j.gap, j.rate, j.accel)):
-        return -1.0  # (the Taylor root, an estimate of the zero: Newton would be in vain)
-    x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, y)
+    taylor = quadratic_taylor_root(j.gap, j.rate, j.accel)  # an estimate of the zero
+    if not safe > step or (safe < end and safe < taylor):
+        return -1.0  # (Newton would be in vain)
+    # Newton starts at the Taylor root (one evaluation fewer than from the bracket's safe
+    # end on a spinning 100-gon), or at that end when the root is within the gap's
+    # roundoff of it (steps from inside would follow roundoff: 20 evaluations on tiny
+    # flights of a chatter)
+    x0 = min(max(taylor, step), end)
+    if (x0 - step) * abs(j.rate) <= j.noise:
+        x0 = step
+    x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, s + x0, y)
     if safe < end and x - s > safe:
         return -1.0
     jr = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, model.gravity))
