@@ -148,6 +148,19 @@ def _pushed_chord(lo, flo, hi, fhi, push):
 
 
 @hot
+def lands_near(jet, B, step, model):
+    """Whether the circle step `step` (the root of its bound F, `circle_step`) ends with
+    the circle's lowest point within four sags of the ground, so that a descent would
+    not go further: the point's height there exceeds F = 0 by at most the bound's loss
+    δ²|r| + Bδ³/3 (its square and cubic terms taken from both sides), compared with
+    four sags of the depth at the start.  A guess at where to spend work, not a bound
+    anything relies on."""
+    px, py, _, _, rx, ry = jet
+    loss = step * step * (math.sqrt(rx * rx + ry * ry) + B * step / 3.0)
+    return loss <= 4.0 * model.sag * math.sqrt(px * px + py * py)
+
+
+@hot
 def rim_step(y, gravity, depth, radius):
     """A step safe for every vertex at once for the rest of the flight: no vertex is more
     than `depth` (Bounds.depth) below the centre, whose height is a parabola, so none

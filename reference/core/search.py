@@ -31,7 +31,7 @@ from .contacts import (
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
 from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent, Jet
-from .rim import circle_step, far_from_ground, rim_descent, rim_step
+from .rim import circle_step, far_from_ground, lands_near, rim_descent, rim_step
 from .roots import (
     p2_positive_at,
     quadratic_first_root,
@@ -191,6 +191,8 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
     rim = rim_step(y, model.gravity, bounds.depth, model.radius)
     if far_from_ground(y, jet, model):
         d_c = max(circle_step(y, jet, model.gravity, B), rim)
+        if lands_near(jet, B, d_c, model):
+            return d_c, last_dlt
         return rim_descent(y, fc, model, bounds.depth, left, d_c), last_dlt
     if not windowed:
         examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
