@@ -3,10 +3,11 @@
     .venv/bin/python benchmarks/reference_speed.py [--repeats 5] [--only TEXT ...]
         [--json FILE] [--no-startup] [--no-sweep]
 
-Every figure is a median over `repeats` runs in one process after an untimed warm-up
-run (compilation and loading are never timed: `stats.compile_s` says what they cost),
-on one core when the machine lets us pin it, with the load average printed before and
-after.  Printed as one table per target, each row with its target and whether it is met:
+Every figure is a median over `repeats` runs (short runs: as many as add up to
+MIN_TIMED_S) in one process after an untimed warm-up run (compilation and loading are
+never timed: `stats.compile_s` says what they cost), on one core when the machine lets
+us pin it, with the load average printed before and after.  Printed as one table per
+target, each row with its target and whether it is met:
 
 1. runs to their end, impacts/s (stats.impacts_per_s): every built-in scene; generic
    tumbling scenes (n = 3 … 10,000, γ = 0, 0.5, 1, flat and three-point ground, fast
@@ -122,11 +123,20 @@ def cases() -> dict[str, Scene]:
 # ----------------------------------------------------------------------------- timing
 
 
+# A run shorter than MIN_TIMED_S / repeats is repeated until its timed runs add up to
+# MIN_TIMED_S (at most MAX_REPEATS runs): five runs of 10 µs are 50 µs of timing, at
+# the mercy of the scheduler and of what the case before left in the caches.
+MIN_TIMED_S = 0.05
+MAX_REPEATS = 5001
+
+
 def measure(name: str, scene: Scene, repeats: int) -> Row:
-    """Median wall time of the run itself (stats.wall_time_s) after a warm-up; a large
-    sample spacing, so the figure is the events' cost (samples at every event remain)."""
+    """Median wall time of the run itself (stats.wall_time_s) after a warm-up, over
+    `repeats` runs or as many as MIN_TIMED_S takes; a large sample spacing, so the
+    figure is the events' cost (samples at every event remain)."""
     opts = ReferenceOptions(sample_dt=scene.run.t_end)
-    simulate(scene, options=opts)
+    warm = simulate(scene, options=opts).stats.wall_time_s
+    repeats = max(repeats, min(MAX_REPEATS, math.ceil(MIN_TIMED_S / max(warm, 1e-9))))
     walls, traj = [], None
     for _ in range(repeats):
         traj = simulate(scene, options=opts)
