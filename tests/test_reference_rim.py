@@ -16,8 +16,8 @@ from tests.oracle import flight as oracle_flight
 from tests.oracle.body import BodyModel
 
 
-def _spinning_flights(scene, count: int, seed: int):
-    """States of the scene's polygon in flight above flat ground: tilt 1e-3 … 0.4 rad,
+def _spinning_flights(count: int, seed: int):
+    """States of a polygon in flight above flat ground: tilt 1e-3 … 0.4 rad,
     spinning fast about its axis (up to 40 rad/s) or tumbling, the circle through the
     vertices 1e-4 … 0.1 a above the ground at the start, falling or rising."""
     rng = np.random.default_rng(seed)
@@ -58,7 +58,7 @@ def test_rim_at_gives_the_oracle_flights_axis_and_its_rate(seed):
     model, _ = core_model(scene)
     i1, _, i3 = scene.body.inertia_diag
     body = BodyModel.from_scene(scene)
-    for y in _spinning_flights(scene, 30, seed):
+    for y in _spinning_flights(30, seed):
         cone = axis_cone(y, flight_constants(y, i1, i3))
         ofc = oracle_flight.flight_constants(body, y)
         for s in (1e-3, 0.02, 0.3):
@@ -91,7 +91,7 @@ def test_rim_descent_never_passes_a_vertex_and_ends_near_the_ground(seed):
     a = scene.body.radius
     body = BodyModel.from_scene(scene)
     checked = ended_near = 0
-    for y in _spinning_flights(scene, 60, seed):
+    for y in _spinning_flights(60, seed):
         fc = flight_constants(y, i1, i3)
         e3 = qt.body_axis(y[3:7])
         if not rim_clear(y[2], a * math.hypot(e3[0], e3[1]), model):

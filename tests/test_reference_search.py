@@ -370,4 +370,3 @@ def test_direction_angle_is_atan2_within_its_error_bound():
              (t, 1), (-1, -t), (1, 1e-300), (-1e-300, 1)]  # fmt: skip
     worst = max(abs(direction_angle(x, y) - math.atan2(y, x)) for x, y in [*xs, *edges])
     assert worst <= ANGLE_ERROR
-    assert 1e-11 < worst  # (the series' remainder, not an exact atan2: the bound matters)

@@ -36,10 +36,9 @@ def free_flight(y0, fc, gravity, s, out):
     """The state after a free flight of duration s from y0, into `out` (closed form)."""
     out[0] = y0[0] + y0[7] * s
     out[1] = y0[1] + y0[8] * s
-    out[2] = y0[2] + y0[9] * s - 0.5 * gravity * s * s
+    out[2], out[9] = centre_height(y0[2], y0[9], gravity, s)
     out[7] = y0[7]
     out[8] = y0[8]
-    out[9] = y0[9] - gravity * s
     p0, p1, p2, p3 = rotation_vector_quaternion(fc.lax * s, fc.lay * s, fc.laz * s)
     a = qmul(p0, p1, p2, p3, y0[3], y0[4], y0[5], y0[6])
     half = 0.5 * fc.lam * s
@@ -50,6 +49,36 @@ def free_flight(y0, fc, gravity, s, out):
     out[10] = fc.lax + fc.lam * e3x
     out[11] = fc.lay + fc.lam * e3y
     out[12] = fc.laz + fc.lam * e3z
+
+
+@hot
+def centre_height(z, vz, gravity, s):
+    """Height and vertical velocity of the centre of mass after a flight of s from
+    (z, v_z): the parabola z + v_z s − g s²/2 and v_z − g s."""
+    return z + vz * s - 0.5 * gravity * s * s, vz - gravity * s
+
+
+@hot
+def precession_axis(fc):
+    """L̂, the axis e3 precesses about (ẑ for a body that does not rotate: any axis
+    serves, e3 then stays put)."""
+    om = fc.omega
+    if om > 0.0:
+        return fc.lax / om, fc.lay / om, fc.laz / om
+    return 0.0, 0.0, 1.0
+
+
+@hot
+def rodrigues_parts(fx, fy, fz, Lx, Ly, Lz):
+    """A body axis f split about L̂ so that Rot(L̂, θ) f = u + cos θ c + sin θ w
+    (Rodrigues): u = (L̂·f) L̂, c = f − u, w = L̂ × f, as (ux, uy, uz, cx, cy, cz, wx, wy,
+    wz)."""
+    lf = Lx * fx + Ly * fy + Lz * fz
+    ux, uy, uz = lf * Lx, lf * Ly, lf * Lz
+    return (
+        ux, uy, uz, fx - ux, fy - uy, fz - uz,
+        Ly * fz - Lz * fy, Lz * fx - Lx * fz, Lx * fy - Ly * fx,
+    )  # fmt: skip
 
 
 @hot
@@ -69,10 +98,10 @@ def flight_acceleration(fc, y, gravity):
 
 @hot
 def _height_terms(fx, fy, fz, Lx, Ly, Lz):
-    """For a body axis f: (L̂·f) L̂_z, f_z − (L̂·f) L̂_z and (L̂ × f)_z, the constant, cosine
-    and sine parts of (Rot(L̂, θ) f)_z (Rodrigues)."""
-    lf = Lx * fx + Ly * fy + Lz * fz
-    return lf * Lz, fz - lf * Lz, Lx * fy - Ly * fx
+    """For a body axis f: the constant, cosine and sine parts of (Rot(L̂, θ) f)_z
+    (`rodrigues_parts`' z components)."""
+    parts = rodrigues_parts(fx, fy, fz, Lx, Ly, Lz)
+    return parts[2], parts[5], parts[8]
 
 
 @hot
@@ -88,10 +117,7 @@ def vertex_height_bounds(y0, fc, radius, gravity):
     So |g″| ≤ g + Σ A_j ω_j² and |g‴| ≤ Σ A_j ω_j³ (z‴ = 0): bounds that shrink with the
     tilt, where a(|ω|² + …) would not."""
     om, lam = fc.omega, fc.lam
-    if om > 0.0:
-        Lx, Ly, Lz = fc.lax / om, fc.lay / om, fc.laz / om
-    else:
-        Lx, Ly, Lz = 0.0, 0.0, 1.0
+    Lx, Ly, Lz = precession_axis(fc)
     R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y0)
     a1, b1, g1 = _height_terms(R00, R10, R20, Lx, Ly, Lz)
     a2, b2, g2 = _height_terms(R01, R11, R21, Lx, Ly, Lz)

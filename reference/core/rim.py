@@ -8,6 +8,7 @@ vertex's, for any n (reference.core.search)."""
 
 import math
 
+from .flight import centre_height, precession_axis, rodrigues_parts
 from .jit import hot
 from .roots import quadratic_first_root
 from .rotation import body_axis
@@ -183,19 +184,14 @@ def rim_root(z, vz, gravity, depth, radius):
 def axis_cone(y, fc):
     """The symmetry axis over a free flight from state y, in closed form: e3 precesses
     about L̂ at Ω (regular precession, `flight`), so its horizontal part is
-    E(s) = u + cos(Ωs) c + sin(Ωs) w (Rodrigues: u the part along L̂, c the rest, w =
-    L̂ × e3; their x, y components) and |Ë3| = Ω²|c| at every s.  Returns (ux, uy, cx,
-    cy, wx, wy, Ω, Ω²|c|)."""
+    E(s) = u + cos(Ωs) c + sin(Ωs) w (`flight.rodrigues_parts`: u the part along L̂, c
+    the rest, w = L̂ × e3; their x, y components) and |Ë3| = Ω²|c| at every s.  Returns
+    (ux, uy, cx, cy, wx, wy, Ω, Ω²|c|)."""
     e3x, e3y, e3z = body_axis(y)
+    Lx, Ly, Lz = precession_axis(fc)
+    ux, uy, _, cx, cy, cz, wx, wy, _ = rodrigues_parts(e3x, e3y, e3z, Lx, Ly, Lz)
     om = fc.omega
-    if not om > 0.0:
-        return e3x, e3y, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    lx, ly, lz = fc.lax / om, fc.lay / om, fc.laz / om
-    le = lx * e3x + ly * e3y + lz * e3z
-    cx, cy, cz = e3x - le * lx, e3y - le * ly, e3z - le * lz
-    wx, wy = ly * e3z - lz * e3y, lz * e3x - lx * e3z
-    c_norm = math.sqrt(cx * cx + cy * cy + cz * cz)
-    return le * lx, le * ly, cx, cy, wx, wy, om, om * om * c_norm
+    return ux, uy, cx, cy, wx, wy, om, om * om * math.sqrt(cx * cx + cy * cy + cz * cz)
 
 
 @hot
@@ -203,11 +199,12 @@ def rim_at(y, cone, model, s):
     """The circle's centre height and rate and a E, a Ė at time s of the flight from y
     (`axis_cone`): (z, v_z, ex, ey, dx, dy)."""
     ux, uy, cx, cy, wx, wy, om, _ = cone
-    a, g = model.radius, model.gravity
+    a = model.radius
     co, si = math.cos(om * s), math.sin(om * s)
+    z, vz = centre_height(y[2], y[9], model.gravity, s)
     return (
-        y[2] + s * (y[9] - 0.5 * g * s),
-        y[9] - g * s,
+        z,
+        vz,
         a * (ux + co * cx + si * wx),
         a * (uy + co * cy + si * wy),
         a * om * (co * wx - si * cx),
