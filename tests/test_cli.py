@@ -95,6 +95,22 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(tmp_path):
         assert "Traceback" not in r.stderr
 
 
+def test_argument_errors_name_the_program_once_and_the_command(capsys):
+    assert main(["nosuch"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("harness: error: argument command: invalid choice: 'nosuch'")
+    assert err.count("harness") == 1
+    assert main(["simulate", "rod", "--dt", "-1"]) == 2
+    assert capsys.readouterr().err.startswith("harness: error: simulate: argument --dt")
+
+
+def test_version_prints_the_installed_distribution_version(capsys):
+    from importlib.metadata import version
+
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"harness {version('euler-disk-harness')}"
+
+
 def test_scenes_lists_every_builtin(capsys):
     from harness.scenes import builtin_names
 

@@ -20,6 +20,7 @@ import traceback
 from reference.scene import SceneError
 
 from ..outputs import OutputError
+from ..provenance import PACKAGE, PROGRAM, distribution_version
 from . import (
     analyze,
     bench,
@@ -51,7 +52,10 @@ COMMANDS = (
 
 
 def build_parser() -> Parser:
-    p = Parser(prog="harness", description=__doc__.splitlines()[0])
+    p = Parser(prog=PROGRAM, description=__doc__.splitlines()[0])
+    p.add_argument(
+        "--version", action="version", version=f"{PROGRAM} {distribution_version(PACKAGE)}"
+    )
     add_verbose(p, top=True)
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     for command in COMMANDS:

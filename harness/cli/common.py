@@ -60,7 +60,10 @@ class Parser(argparse.ArgumentParser):
         self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message: str) -> None:  # one clear line, exit 2
-        raise BadInput(f"{self.prog}: {message}")
+        """main() prints `harness: error: …`: the message names the sub-command (`simulate:
+        …`), not the program a second time."""
+        command = self.prog.partition(" ")[2]
+        raise BadInput(f"{command}: {message}" if command else message)
 
 
 # ----------------------------------------------------------------------------- types
