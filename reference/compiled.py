@@ -59,6 +59,11 @@ def _load_aot():
     environment variable EULER_DISK_NO_AOT is set)."""
     if os.environ.get("EULER_DISK_NO_AOT"):
         return None
+    return fresh_aot_module()
+
+
+def fresh_aot_module():
+    """The ahead-of-time module beside the sources if its stamp matches them, else None."""
     try:
         stamp = STAMP_FILE.read_text().strip()
     except OSError:

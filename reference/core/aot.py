@@ -1,9 +1,11 @@
-"""Build the core ahead of time: `python -m reference.core.aot` (run by `make setup`).
-numba.pycc compiles the event loop `loop.run_events` and the row-wise functions of
-`arrays` (and everything they call) into the extension module reference/core/_aot*.so,
-and a stamp of the core's sources is written beside it (reference.compiled ignores the
-module once the sources change).  Needs a C compiler; without one the functions are
-compiled just in time on first use instead."""
+"""Build the core ahead of time: `python -m reference.core.aot` (run by `make setup`; the
+package's build step, setup.py, calls `build` too, so `pip install .`, `pip install -e .`
+and `pip wheel .` carry the same module).  numba.pycc compiles the event loop
+`loop.run_events` and the row-wise functions of `arrays` (and everything they call) into
+the extension module reference/core/_aot*.so, and a stamp of the core's sources is
+written beside it (reference.compiled ignores the module once the sources change).
+Needs a C compiler; without one (or without numba.pycc) the functions are compiled just
+in time on first use instead.  Why pycc: docs/development.md."""
 
 from __future__ import annotations
 
@@ -43,34 +45,51 @@ def signatures() -> dict:
     }
 
 
-def build() -> Path:
-    """Compile the module and write its stamp; returns the module's path."""
+def build(output_dir: Path = CORE_DIR) -> Path:
+    """Compile the module into output_dir and write its stamp there; returns the
+    module's path."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pycc announces its pending deprecation
         from numba.pycc import CC
 
     from reference.compiled import STAMP_FILE, jit_function, source_stamp
 
+    output_dir.mkdir(parents=True, exist_ok=True)
     cc = CC("_aot")
-    cc.output_dir = str(CORE_DIR)
+    cc.output_dir = str(output_dir)
     cc.verbose = False
     for name, sig in signatures().items():
         cc.export(name, sig)(jit_function(name).py_func)
     cc.compile()
-    STAMP_FILE.write_text(source_stamp() + "\n")
-    return next(CORE_DIR.glob("_aot*.so"))
+    (output_dir / STAMP_FILE.name).write_text(source_stamp() + "\n")
+    return output_dir / cc.output_file
 
 
-def main() -> int:
+def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
+    """`build`, timed and announced; when it cannot be done (no C compiler, no
+    numba.pycc) one line on stderr says so and None is returned: the loop is then
+    compiled just in time on first use."""
     t0 = time.perf_counter()
     print("building the reference's event loop ahead of time (about a minute) ...", flush=True)
     try:
-        path = build()
-    except Exception as exc:  # no compiler: the loop is compiled just in time instead
+        path = build(output_dir)
+    except Exception as exc:  # any failure: the loop is compiled just in time instead
         print(f"ahead-of-time build skipped ({type(exc).__name__}: {exc}); the loop will be "
               "compiled just in time on first use", file=sys.stderr)  # fmt: skip
+        return None
+    print(f"built {path.name} in {time.perf_counter() - t0:.0f} s", flush=True)
+    return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Build unless the module beside the sources is already fresh (`--force`: always)."""
+    from reference.compiled import fresh_aot_module
+
+    args = sys.argv[1:] if argv is None else argv
+    if "--force" not in args and fresh_aot_module() is not None:
+        print("the reference's ahead-of-time module is up to date", flush=True)
         return 0
-    print(f"built {path.name} in {time.perf_counter() - t0:.0f} s")
+    build_or_explain()
     return 0
 
 

@@ -1,0 +1,45 @@
+"""The package's build step: the reference's compiled core (reference/core/_aot*.so and
+its stamp) is an optional extension module built by `reference.core.aot.build`, so that
+`pip install .`, `pip install -e .` and `pip wheel .` carry the same module as `make
+setup`.  Without a C compiler (or without numba.pycc) the build says so in one line and
+goes on: the core is then compiled just in time on first use (docs/development.md).
+Everything else about the package is in pyproject.toml."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+
+ROOT = Path(__file__).resolve().parent
+CORE_MODULE = "reference.core._aot"
+
+
+class BuildCompiledCore(build_ext):
+    """build_ext for the one module numba.pycc compiles (it runs the C compiler itself)."""
+
+    def build_extension(self, ext: Extension) -> None:
+        if str(ROOT) not in sys.path:
+            sys.path.insert(0, str(ROOT))  # the sources being built, not an installed copy
+        from reference.core import aot
+
+        aot.build_or_explain(Path(self.get_ext_fullpath(ext.name)).parent)
+
+    def copy_extensions_to_source(self) -> None:
+        """An editable install (`pip install -e .`) uses the sources in place: the stamp
+        goes beside the module."""
+        super().copy_extensions_to_source()
+        from reference.compiled import STAMP_FILE
+
+        built = Path(self.get_ext_fullpath(CORE_MODULE)).parent / STAMP_FILE.name
+        if built.exists():
+            shutil.copyfile(built, STAMP_FILE)
+
+
+setup(
+    ext_modules=[Extension(CORE_MODULE, sources=[], optional=True)],
+    cmdclass={"build_ext": BuildCompiledCore},
+)
