@@ -13,35 +13,13 @@ from collections.abc import Callable
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
+from .interface import engine_entry
+
 # Largest polygon the engines and the linear model take.  Engines: one contact sphere per
 # vertex; at n = 1e5 MuJoCo needs 18 s for its first ten steps (building the model) and
 # PyBullet 136 s for two (measured); at 1e4 both run (0.8 s and 3.2 s for 100 steps).
 # Linear model: O(n^2) memory, 0.93 GB at n = 1e4.
 MAX_VERTICES = 10_000
-
-
-def engine_entry(
-    fixed_step: bool = True,
-    library: str | None = None,
-    max_vertices: int | None = None,
-    reports_progress: bool = False,
-) -> Callable[[Callable], Callable]:
-    """Mark a `simulate(scene, *, dt, t_end)` callable as an engine entry point; `library`
-    names the distribution of the physics engine it wraps (shown by `harness engines`);
-    `max_vertices` is the largest n it takes (harness.simulators.check_run refuses larger
-    ones before the run); `reports_progress`: it accepts `progress=callback(done, total)`
-    and calls it during long runs."""
-
-    def mark(fn: Callable) -> Callable:
-        fn.fixed_step = fixed_step
-        if library is not None:
-            fn.library = library
-        if max_vertices is not None:
-            fn.max_vertices = max_vertices
-        fn.reports_progress = reports_progress
-        return fn
-
-    return mark
 
 
 def _profile(

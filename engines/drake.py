@@ -66,21 +66,21 @@ from reference.trajectory import Status, Trajectory
 
 from .base import (
     build_trajectory,
-    contact_kinematics,
     effective_contact_mass,
     initial_state,
     scene_points,
     typical_impact_speed,
 )
+from .stepping import SPHERE_RADIUS_FRACTION, Rows, first_failure, run_steps
 
 PROFILES = ("sap", "continuous")
 ENGINE_NAMES = {"sap": "drake", "continuous": "drake-continuous"}
 
-# Contact sphere radius / body radius: any r gives the exact point contact (module
-# docstring); 1e-3 as in the MuJoCo and PyBullet models.
-SPHERE_RADIUS_FRACTION = 1e-3
+# Contact sphere radius / body radius: engines.stepping.SPHERE_RADIUS_FRACTION (any r gives
+# the exact point contact, module docstring).
 # three_point: half-thickness of the body's contact box (only its bottom face is touched);
-# a bump deeper than this would come out of the top: the fall-through depth too.
+# a bump deeper than this would come out of the top (engines.stepping.FALL_THROUGH_DEPTH
+# ends the run before).
 FACE_HALF_THICKNESS_FRACTION = 0.1
 # SAP: steps per contact.  The implicit step loses energy even without a damper: with
 # τ = 0 the bounce is e_max(N) ≈ exp(−π²/(2N)) (0.79 at N = 20, measured in Drake), so N
@@ -100,8 +100,6 @@ CONTINUOUS_MAX_ACCURACY = 1e-3
 # The continuous profile's smallest restitution at the typical speed: γ = 0 is taken as
 # 0.01 (u = d v* = 100; Drake's guide calls d > 500 s/m unphysical and hard on solvers).
 HC_MIN_RESTITUTION = 0.01
-# A contact point this far below its ground (in body radii) has fallen through.
-FALL_THROUGH_DEPTH = FACE_HALF_THICKNESS_FRACTION
 
 
 class _HalfSpaceNotice(logging.Filter):
@@ -421,6 +419,7 @@ def simulate_drake(
     the maximum step) until t_end (scene.run.t_end by default) and return its Trajectory:
     one row per step, impacts from contact onsets (engines.base).  Status `failed` (the
     run stops) on a non-finite state or when a contact point is FALL_THROUGH_DEPTH·a
+    (engines.stepping)
     below its ground; stats: wall_time_s, steps, steps_per_s and the profile's parameters."""
     if profile not in PROFILES:
         raise ValueError(f"unknown Drake profile {profile!r}; choose from {', '.join(PROFILES)}")
@@ -429,53 +428,80 @@ def simulate_drake(
     return run_with_settings(scene, contact_settings(scene, dt, profile), t_end)
 
 
-def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None = None):
-    """`simulate_drake` with explicit settings (the restitution study varies them)."""
-    from pydrake.systems.framework import EventStatus
+class _SimulatorStepper:
+    """engines.stepping.Stepper over a Drake Simulator: its monitor records every step
+    (time, state, normal forces) and ends the simulation at the first row that fails the
+    run loop's checks (so that a broken run stops at once, not at the chunk's end)."""
 
+    def __init__(self, scene: Scene, model: DrakeModel, t_end: float, dt: float) -> None:
+        from pydrake.systems.framework import EventStatus
+
+        self.t_end, self.dt = t_end, dt
+        self.sim = _simulator(model, initial_state(scene.initial))
+        self.times: list[float] = []
+        self.rows: list[np.ndarray] = []
+        self.forces: list[np.ndarray] = []
+        self.first = 0
+        self.started = False
+        plant, n_contacts = model.plant, scene.n_contacts
+
+        def monitor(root_context):
+            pc = plant.GetMyContextFromRoot(root_context)
+            x = plant.GetPositionsAndVelocities(pc)
+            self.times.append(root_context.get_time())
+            self.rows.append(x.copy())
+            self.forces.append(normal_forces(model, pc, n_contacts))
+            failure = first_failure(scene, from_drake_state(x)[None])
+            if failure is not None:
+                return EventStatus.ReachedTermination(model.diagram, failure[1])
+            return EventStatus.Succeeded()
+
+        self.sim.set_monitor(monitor)
+
+    def advance(self, steps: int) -> Rows:
+        self.first = len(self.times)
+        target = self.sim.get_context().get_time() + steps * self.dt
+        if target >= self.t_end - 0.5 * self.dt:  # the last chunk ends at t_end exactly
+            target = self.t_end
+        broken = None
+        try:
+            if not self.started:
+                self.started = True
+                self.sim.Initialize()
+            self.sim.AdvanceTo(target)
+        except RuntimeError as exc:  # e.g. the integrator cannot meet its accuracy
+            broken = f"Drake stopped: {exc}"
+        new = self.rows[self.first :]
+        states = from_drake_state(np.array(new)) if new else np.zeros((0, 13))
+        return Rows(np.array(self.times[self.first :]), states, broken)
+
+    def cut(self, keep: int) -> None:
+        end = self.first + keep
+        del self.times[end:], self.rows[end:], self.forces[end:]
+
+    def settle(self) -> float:
+        kept = min(len(self.times), len(self.rows), len(self.forces))
+        self.cut(kept - self.first)
+        return self.times[-1] if self.times else 0.0
+
+
+def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None = None):
+    """`simulate_drake` with explicit settings (the restitution study varies them).  One
+    chunk of the run loop (engines.stepping.run_steps) to t_end: Drake's Simulator takes
+    its own steps (error-controlled on the continuous plant), which a chunk boundary
+    would cut."""
     t_wall = time.perf_counter()
     t_end = scene.run.t_end if t_end is None else float(t_end)
     model = build_model(scene, settings)
-    y0 = initial_state(scene.initial)
-    sim = _simulator(model, y0)
-    plant = model.plant
+    dt = settings.time_step or settings.max_step
+    n_steps = max(1, int(round(t_end / dt)))
+    stepper = _SimulatorStepper(scene, model, t_end, dt)
+    loop = run_steps(stepper, scene, n_steps, n_steps, t_end=t_end)
+    status, message = loop.status, loop.message
     n_contacts = scene.n_contacts
-    times: list[float] = []
-    rows: list[np.ndarray] = []
-    forces: list[np.ndarray] = []
-    depth_limit = -FALL_THROUGH_DEPTH * scene.body.radius
-    failure: list[str] = []
-
-    def monitor(root_context):
-        pc = plant.GetMyContextFromRoot(root_context)
-        x = plant.GetPositionsAndVelocities(pc)
-        t = root_context.get_time()
-        times.append(t)
-        rows.append(x.copy())
-        forces.append(normal_forces(model, pc, n_contacts))
-        y = from_drake_state(x)
-        if not np.all(np.isfinite(y)):
-            failure.append(f"Drake's state became non-finite at t = {t:.6g}")
-        elif contact_kinematics(scene, y[None])[0].min() < depth_limit:
-            failure.append(f"the body fell through the ground at t = {t:.6g}")
-        if failure:
-            return EventStatus.ReachedTermination(model.diagram, failure[-1])
-        return EventStatus.Succeeded()
-
-    sim.set_monitor(monitor)
-    status, message = Status.T_END, f"reached t_end = {t_end:g}"
-    stepping = time.perf_counter()
-    try:
-        sim.Initialize()
-        sim.AdvanceTo(t_end)
-    except RuntimeError as exc:  # e.g. the integrator cannot meet its accuracy
-        failure.append(f"Drake stopped: {exc}")
-    stepping = time.perf_counter() - stepping
-    if failure:
-        status, message = Status.FAILED, failure[-1]
-    t = np.array(times)
-    states = from_drake_state(np.array(rows)) if rows else np.zeros((0, 13))
-    F = np.array(forces) if forces else np.zeros((0, n_contacts))
+    t = np.array(stepper.times)
+    states = from_drake_state(np.array(stepper.rows)) if stepper.rows else np.zeros((0, 13))
+    F = np.array(stepper.forces) if stepper.forces else np.zeros((0, n_contacts))
     if status is Status.FAILED:  # keep the finite rows only
         ok = np.all(np.isfinite(states), axis=1)
         t, states, F = t[ok], states[ok], F[ok]
@@ -484,7 +510,7 @@ def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None
     stats = {
         "wall_time_s": time.perf_counter() - t_wall,
         "steps": steps,
-        "steps_per_s": steps / stepping if stepping > 0 else None,
+        "steps_per_s": steps / loop.stepping_s if loop.stepping_s > 0 else None,
         "profile": settings.profile,
         "stiffness": settings.stiffness,
         "hc_dissipation": settings.hc_dissipation,
@@ -495,7 +521,8 @@ def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None
         "restitution_model": settings.restitution_model,
         "drake_version": _drake_version(),
     }
-    dt = settings.time_step or settings.max_step
+    if loop.interrupted:
+        stats["interrupted"] = True
     return build_trajectory(
         scene, ENGINE_NAMES[settings.profile], dt, t, states, impulses, status, message, stats
     )

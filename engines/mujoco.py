@@ -44,16 +44,14 @@ from reference.geometry import free_acceleration, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
-from .base import build_trajectory, contact_kinematics
-from .mujoco_model import FACE_HALF_THICKNESS_FRACTION, contact_settings, load_model
+from .base import build_trajectory
+from .mujoco_model import contact_settings, load_model
+from .stepping import Rows, run_steps
 
 ENGINE_NAMES = {"tuned": "mujoco", "default": "mujoco-default"}
 STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
 # Steps per rollout call: bounds the memory of one call and lets a broken run stop early.
 CHUNK_STEPS = 200_000
-# A contact point this far below its ground (in body radii) has fallen through it: the
-# three_point face's half-thickness, past which MuJoCo would push a bump out the top.
-FALL_THROUGH_DEPTH = FACE_HALF_THICKNESS_FRACTION
 
 
 # --------------------------------------------------------------------------- states
@@ -162,6 +160,55 @@ def run_mujoco(
     return run
 
 
+class _RolloutStepper:
+    """engines.stepping.Stepper over `mujoco.rollout`: one rollout call per chunk, one
+    step more than kept, so that the contact force at the chunk's last state is known.
+    rows[i] are rollout rows (time, qpos, qvel, ...); forces[i] the contact forces at
+    the state of rows[i]."""
+
+    def __init__(self, scene: Scene, model, data, dt: float) -> None:
+        self.scene, self.model, self.dt = scene, model, dt
+        self.nq, self.nv = model.nq, model.nv
+        self.state = np.empty(mujoco.mj_stateSize(model, STATE_SPEC))
+        mujoco.mj_getState(model, data, self.state, STATE_SPEC)
+        self.data = data
+        self.rows = [self.state[None].copy()]
+        self.forces: list[np.ndarray] = []
+        self.after = None  # the state one step past the last row, when known
+        self.done = 0
+        self.n_steps = 0  # set by run: the last chunk keeps its extra force row
+
+    def advance(self, steps: int) -> Rows:
+        done, dt = self.done, self.dt
+        # from state `done`: st[i] = state done + i + 1, sd[i] = sensors at state done + i
+        st, sd = rollout.rollout(self.model, self.data, self.state[None], nstep=steps + 1)
+        st, sd = st[0], sd[0][:, 0::3]  # contact-frame force: normal component first
+        ok = _valid_rows(st, done * dt, dt)
+        if ok < steps + 1:
+            self.rows.append(st[:ok])
+            self.forces.append(sd[:ok])
+            self.after = None
+            why = f"MuJoCo's state became invalid (NaN or reset) at t = {(done + ok) * dt:.6g}"
+            return Rows(st[:ok, 0], _states(st[:ok], self.nq, self.nv), broken=why)
+        last = done + steps == self.n_steps
+        self.rows.append(st[:steps])
+        self.forces.append(sd[: steps + 1 if last else steps])
+        self.after = st[steps]
+        self.done = done + steps
+        self.state = st[steps - 1].copy()
+        return Rows(st[:steps, 0], _states(st[:steps], self.nq, self.nv))
+
+    def cut(self, keep: int) -> None:
+        rows = self.rows[-1]
+        self.after = rows[keep] if keep < len(rows) else None
+        self.rows[-1] = rows[:keep]
+        self.forces[-1] = self.forces[-1][: keep + 1]
+
+    def settle(self) -> float:  # rows are appended only after a whole rollout
+        self.rows, self.after = [np.concatenate(self.rows)[: self.done + 1]], None
+        return self.done * self.dt
+
+
 def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
     t_wall = time.perf_counter()
     if profile not in ENGINE_NAMES:
@@ -174,67 +221,21 @@ def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
     y0 = initial_state(scene.initial)
     half = settings.half_step_velocities if half_step is None else half_step
     set_state(model, data, staggered_start(scene, y0, dt) if half else y0)
-    depth_limit = -FALL_THROUGH_DEPTH * scene.body.radius
+    stepper = _RolloutStepper(scene, model, data, dt)
+    stepper.n_steps = n_steps
+    loop = run_steps(stepper, scene, n_steps, CHUNK_STEPS, progress)
+    status, message = loop.status, loop.message
+
     nq, nv = model.nq, model.nv
-
-    state = np.empty(mujoco.mj_stateSize(model, STATE_SPEC))
-    mujoco.mj_getState(model, data, state, STATE_SPEC)
-    rows = [state[None].copy()]  # rollout rows: (time, qpos, qvel, ...)
-    forces: list[np.ndarray] = []  # forces[i] at the state of row i
-    after = None  # the state one step past the last row, when known
-    status, message = Status.T_END, ""
-    stepping = 0.0
-    done = 0
-    interrupted = False
-    try:
-        while done < n_steps:
-            if progress is not None:
-                progress(done, n_steps)
-            chunk = min(CHUNK_STEPS, n_steps - done)
-            last = done + chunk == n_steps
-            # from state `done`: st[i] = state done + i + 1, sd[i] = sensors at state done + i;
-            # one step more than kept, so the force at the chunk's last state is known
-            t0 = time.perf_counter()
-            st, sd = rollout.rollout(model, data, state[None], nstep=chunk + 1)
-            stepping += time.perf_counter() - t0
-            st, sd = st[0], sd[0][:, 0::3]  # contact-frame force: normal component first
-            ok = _valid_rows(st, done * dt, dt)
-            if ok < chunk + 1:
-                status = Status.FAILED
-                message = (
-                    f"MuJoCo's state became invalid (NaN or reset) at t = {(done + ok) * dt:.6g}"
-                )
-                rows.append(st[:ok])
-                forces.append(sd[:ok])
-                break
-            rows.append(st[:chunk])
-            forces.append(sd[: chunk + 1 if last else chunk])
-            after = st[chunk]
-            done += chunk
-            state = st[chunk - 1].copy()
-            lowest = contact_kinematics(scene, _states(rows[-1], nq, nv))[0].min(axis=1)
-            if lowest.min() < depth_limit:
-                status = Status.FAILED
-                bad = int(np.argmax(lowest < depth_limit))
-                message = f"the body fell through the ground at t = {rows[-1][bad, 0]:.6g}"
-                after = rows[-1][bad + 1] if bad + 1 < len(rows[-1]) else None
-                rows[-1] = rows[-1][: bad + 1]
-                forces[-1] = forces[-1][: bad + 2]
-                break
-    except KeyboardInterrupt:  # keep the whole steps done so far
-        interrupted = True
-        status = Status.FAILED
-        message = f"interrupted (Ctrl-C) at t = {done * dt:.6g}; the steps before are kept"
-        rows, after = [np.concatenate(rows)[: done + 1]], None
-
-    rows_all = np.concatenate(rows)
+    rows_all = np.concatenate(stepper.rows)
     t = dt * np.arange(len(rows_all))  # = MuJoCo's time, without its accumulated roundoff
     states = _states(rows_all, nq, nv)
-    F = np.concatenate(forces)
+    F = np.concatenate(stepper.forces) if stepper.forces else np.zeros((0, scene.n_contacts))
     if len(F) < len(t):  # a failed run: no force known at the last valid state
         F = np.concatenate([F, np.zeros((len(t) - len(F), scene.n_contacts))])
     impulses = np.clip(F[: len(t)], 0.0, None) * dt
     if half:
+        after = stepper.after
         y_after = _states(after[None], nq, nv)[0] if after is not None else None
         states = whole_step_velocities(scene, states, y_after, impulses > 0.0, dt)
         states[0, 7:13] = y0[7:13]  # known exactly: MuJoCo started from v(−h/2) built from it
@@ -242,7 +243,7 @@ def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
     stats = {
         "wall_time_s": time.perf_counter() - t_wall,
         "steps": steps,
-        "steps_per_s": steps / stepping if stepping > 0 else None,
+        "steps_per_s": steps / loop.stepping_s if loop.stepping_s > 0 else None,
         "profile": profile,
         "integrator": settings.integrator or "Euler (MuJoCo default)",
         "solref": list(settings.solref) if settings.solref else "MuJoCo default",
@@ -251,7 +252,7 @@ def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
         "restitution_model": settings.restitution_model,
         "mujoco_version": mujoco.__version__,
     }
-    if interrupted:
+    if loop.interrupted:
         stats["interrupted"] = True
     return MujocoRun(scene, profile, dt, t, states, impulses, status, message, stats)
 

@@ -29,20 +29,21 @@ import mujoco
 from reference.scene import Scene
 
 from .base import scene_points
+from .stepping import SPHERE_RADIUS_FRACTION
 
 PROFILES = ("tuned", "default")
 # intprm[0] of a contact sensor: the bit set of its data fields; 2 = "force" (the MJCF
 # attribute data="force" compiles to it, read back from MjSpec.from_string).
 CONTACT_SENSOR_DATA_FORCE = 2
 
-# Contact sphere radius as a fraction of the body radius.  Any r gives the exact point
-# contact (see the module docstring); 1e-3 keeps the geoms' bounding boxes tight without
-# approaching the collision code's absolute tolerances.
-SPHERE_RADIUS_FRACTION = 1e-3
+# Contact sphere radius as a fraction of the body radius: engines.stepping's
+# SPHERE_RADIUS_FRACTION.  Any r gives the exact point contact (see the module docstring);
+# 1e-3 keeps the geoms' bounding boxes tight without approaching the collision code's
+# absolute tolerances.
 # Half-thickness of the three_point contact face (a cylinder of the body's radius).  Only
 # its bottom face is ever touched; its mass is ignored because <inertial> is explicit.  A
-# bump deeper than the half-thickness would be pushed out through the top face, so this is
-# also the depth at which engines/mujoco.py declares a fall-through (FALL_THROUGH_DEPTH).
+# bump deeper than the half-thickness would be pushed out through the top face; the run
+# loop (engines.stepping.FALL_THROUGH_DEPTH) ends the run before that.
 FACE_HALF_THICKNESS_FRACTION = 0.1
 
 # MuJoCo's own defaults, written out where the default profile uses them.

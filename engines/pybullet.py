@@ -61,6 +61,7 @@ import numpy as np
 
 from engines.base import build_trajectory
 from engines.quiet import quiet_import
+from engines.stepping import SPHERE_RADIUS_FRACTION, Rows, run_steps
 from reference import quaternion as qt
 from reference.geometry import energies, initial_state
 from reference.scene import Scene
@@ -71,20 +72,13 @@ pb = quiet_import("pybullet")  # it prints its build time to the terminal on imp
 PROFILES = ("tuned", "default")
 ENGINE_NAMES = {"tuned": "pybullet", "default": "pybullet-default"}
 
-# Radius of the contact spheres relative to the body radius a.  Any value from 1e-2 to
-# 1e-6 gave the same impacts (docs/engines.md); it must be small against a so the
-# three_point distance error r(1 − cos α) and the mapping of points to vertices are
-# negligible, and large against roundoff of the positions (1e-16 a).
-SPHERE_RADIUS = 1e-3
-# Steps between two progress reports (about a second of stepping at 5e4 steps/s).
-PROGRESS_EVERY = 50_000
+# Steps per chunk of the run loop (engines.stepping): progress and the fall-through
+# check come after every chunk.
+CHUNK_STEPS = 1_000
 # Thickness of the body face used on three_point ground, relative to a.  Only its bottom
 # face (the mid-plane) touches the bumps; thick enough that a bump never crosses the
 # whole box in one step of a sane run.
 FACE_THICKNESS = 0.05
-# A body whose mean contact gap (the height of its centre above the contact plane) is
-# below −FALL_THROUGH · a has gone through the ground.
-FALL_THROUGH = 0.05
 
 
 @dataclass(frozen=True)
@@ -234,7 +228,7 @@ def _processing_threshold(scene: Scene, dt: float, profile: str) -> float | None
 def _write_urdf(scene: Scene, directory: str) -> str:
     path = os.path.join(directory, "body.urdf")
     with open(path, "w") as fh:
-        fh.write(body_urdf(scene, SPHERE_RADIUS * scene.body.radius))
+        fh.write(body_urdf(scene, SPHERE_RADIUS_FRACTION * scene.body.radius))
     return path
 
 
@@ -256,7 +250,7 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
     cid = {"physicsClientId": client}
     g = scene.gravity
     a = scene.body.radius
-    r = SPHERE_RADIUS * a
+    r = SPHERE_RADIUS_FRACTION * a
     tuned = profile == "tuned"
     # Maximal coordinates (btRigidBody) in the tuned profile: the rigid-body solver is
     # the one whose split impulse and restitution the settings above control.  The
@@ -367,6 +361,72 @@ def contact_forces(h: Handles, scene: Scene) -> np.ndarray:
 # ----------------------------------------------------------------------------- run
 
 
+class _Stepper:
+    """engines.stepping.Stepper over one PyBullet world: steps one at a time, collects
+    the processed contact points with a force as hits (step j, bump k, point on the body
+    x, y, z, normal force) and records the state (step index and raw pose and velocity
+    tuples): on flat ground every step while the body has manifold points (they appear a
+    few steps before a vertex can touch, so the step before every onset is recorded), on
+    the sample grid otherwise; sphere–box points appear only at penetration, so on
+    three_point ground every step."""
+
+    def __init__(
+        self, h: Handles, dt: float, sample_every: int, every_step: bool, n_steps: int
+    ) -> None:
+        self.h, self.dt, self.sample_every, self.every_step = h, dt, sample_every, every_step
+        self.n_steps = n_steps
+        self.ground_index = {gid: k for k, gid in enumerate(h.ground)}
+        self.j = self.first = 0
+        self.rows_j: list[int] = [0]
+        self.rows_raw: list[tuple] = [self._read()]
+        self.hits: list[tuple] = []
+
+    def _read(self) -> tuple:
+        client, body = self.h.client, self.h.body
+        return pb.getBasePositionAndOrientation(body, physicsClientId=client) + pb.getBaseVelocity(
+            body, physicsClientId=client
+        )
+
+    def advance(self, steps: int) -> Rows:
+        client, body, threshold = self.h.client, self.h.body, self.h.processing_threshold
+        step, contacts, read = pb.stepSimulation, pb.getContactPoints, self._read
+        rows_j, rows_raw, hits, ground_index = (
+            self.rows_j,
+            self.rows_raw,
+            self.hits,
+            self.ground_index,
+        )
+        first = self.first = len(rows_j)
+        last_step = self.j + steps
+        for j in range(self.j + 1, last_step + 1):
+            self.j = j
+            step(physicsClientId=client)
+            cps = contacts(bodyA=body, physicsClientId=client)
+            for cp in cps:
+                if cp[9] > 0.0 and cp[8] <= threshold:
+                    p = cp[5]
+                    hits.append((j, ground_index.get(cp[2], 0), p[0], p[1], p[2], cp[9]))
+            if self.every_step or cps or j % self.sample_every == 0 or j == self.n_steps:
+                rows_j.append(j)
+                rows_raw.append(read())
+        return Rows(np.array(rows_j[first:]) * self.dt, _states(rows_raw[first:]))
+
+    def cut(self, keep: int) -> None:
+        del self.rows_j[self.first + keep :], self.rows_raw[self.first + keep :]
+        self._drop_hits_after(self.rows_j[-1])
+
+    def settle(self) -> float:
+        kept = min(len(self.rows_j), len(self.rows_raw))
+        del self.rows_j[kept:], self.rows_raw[kept:]
+        self._drop_hits_after(self.rows_j[-1])
+        return self.rows_j[-1] * self.dt
+
+    def _drop_hits_after(self, j_last: int) -> None:
+        """Hits of steps after the last recorded row (every step with hits is recorded)."""
+        while self.hits and self.hits[-1][0] > j_last:
+            self.hits.pop()
+
+
 def simulate_pybullet(
     scene: Scene,
     dt: float,
@@ -377,14 +437,15 @@ def simulate_pybullet(
 ) -> Trajectory:
     """Run the scene in PyBullet at fixed step dt up to t_end (scene.run.t_end by default).
 
-    `progress(done, total)` is called every PROGRESS_EVERY steps.  Ctrl-C stops the run
-    after the current step: status failed, stats["interrupted"], the steps so far kept.
+    Stepped by the shared run loop (engines.stepping.run_steps) in chunks of CHUNK_STEPS:
+    `progress(done, total)` before every chunk; Ctrl-C stops the run after the current
+    step: status failed, stats["interrupted"], the steps so far kept.
 
     Rows of the result: t = 0 (the initial state read back from PyBullet), every step
     around contact activity, and every `sample_every`-th step in between (default: steps
     of about 1e-3 √(a/g), at least every step).  Impacts come from contact onsets
-    (`engines.base`).  Status `failed` (and the run stops) on a non-finite state or when
-    the body's centre is more than FALL_THROUGH·a below its contact plane.
+    (`engines.base`).  Status `failed` (and the run stops) on a non-finite state or when a
+    contact point is more than FALL_THROUGH_DEPTH·a below its ground.
 
     stats: wall_time_s and steps_per_s of the stepping loop (engine steps and the reads
     it needs), steps, setup_time_s (building the world), assembly_time_s
@@ -405,68 +466,19 @@ def simulate_pybullet(
     setup0 = time.perf_counter()
     h = build_world(scene, dt, profile)
     setup = time.perf_counter() - setup0
-    client, body = h.client, h.body
-    step = pb.stepSimulation
-    contacts = pb.getContactPoints
-    threshold = h.processing_threshold
-    ground_index = {gid: k for k, gid in enumerate(h.ground)}
-
-    # Per recorded step: its index and the raw state tuples; per processed contact point
-    # with a force: (step j, bump k, point on the body x, y, z, normal force).
-    rows_j: list[int] = []
-    rows_raw: list[tuple] = []
-    hits: list[tuple] = []
-    status, message = Status.T_END, f"reached t_end = {t_end:g}"
-    get_pose, get_vel = pb.getBasePositionAndOrientation, pb.getBaseVelocity
-    limit = -FALL_THROUGH * a
-    every_step = not flat
-    wall0 = time.perf_counter()
-    interrupted = False
+    stepper = _Stepper(h, dt, sample_every, every_step=not flat, n_steps=n_steps)
     try:
-        rows_j.append(0)
-        rows_raw.append(
-            get_pose(body, physicsClientId=client) + get_vel(body, physicsClientId=client)
-        )
-        for j in range(1, n_steps + 1):
-            if progress is not None and j % PROGRESS_EVERY == 0:
-                progress(j, n_steps)
-            step(physicsClientId=client)
-            cps = contacts(bodyA=body, physicsClientId=client)
-            for cp in cps:
-                if cp[9] > 0.0 and cp[8] <= threshold:
-                    p = cp[5]
-                    hits.append((j, ground_index.get(cp[2], 0), p[0], p[1], p[2], cp[9]))
-            # State: on flat ground every step while the body has manifold points (they
-            # appear a few steps before a vertex can touch, so the step before every
-            # onset is recorded), on the sample grid otherwise.  Sphere–box points appear
-            # only at penetration: on three_point ground every step.
-            if every_step or cps or j % sample_every == 0 or j == n_steps:
-                pose = get_pose(body, physicsClientId=client)
-                vel = get_vel(body, physicsClientId=client)
-                rows_j.append(j)
-                rows_raw.append(pose + vel)
-                depth = _centre_depth(pose, flat)
-                check = depth + sum(pose[0]) + sum(pose[1]) + sum(vel[0]) + sum(vel[1])
-                if not (depth > limit and check - check == 0.0):
-                    status = Status.FAILED
-                    what = "fell through the ground" if depth <= limit else "non-finite state"
-                    message = f"the body {what} at t = {j * dt:.6g}"
-                    break
-    except KeyboardInterrupt:  # keep the rows read so far
-        interrupted = True
-        status = Status.FAILED
-        message = f"interrupted (Ctrl-C) at t = {rows_j[-1] * dt:.6g}; the steps before are kept"
-        kept = min(len(rows_j), len(rows_raw))
-        del rows_j[kept:], rows_raw[kept:]
+        loop = run_steps(stepper, scene, n_steps, CHUNK_STEPS, progress, t_end=t_end)
     finally:
-        pb.disconnect(client)
-    wall = time.perf_counter() - wall0
+        pb.disconnect(h.client)
+    wall = loop.stepping_s
+    status, message = loop.status, loop.message
 
     post0 = time.perf_counter()
-    J = np.array(rows_j)
-    Y = _states(rows_raw)
+    J = np.array(stepper.rows_j)
+    Y = _states(stepper.rows_raw)
     steps_run = int(J[-1])
-    impulses = _impulses(hits, J, Y, flat, scene.body.n, n_contacts, dt)
+    impulses = _impulses(stepper.hits, J, Y, flat, scene.body.n, n_contacts, dt)
     keep = _rows_to_keep(J, impulses, sample_every, steps_run)
     if status is Status.FAILED:  # keep the finite rows only
         keep &= np.all(np.isfinite(Y), axis=1)
@@ -479,7 +491,7 @@ def simulate_pybullet(
         "rows_read": int(len(J)),
         "rows_kept": int(keep.sum()),
     }
-    if interrupted:
+    if loop.interrupted:
         stats["interrupted"] = True
     traj = build_trajectory(
         scene,
@@ -495,21 +507,6 @@ def simulate_pybullet(
     )
     traj.stats["assembly_time_s"] = time.perf_counter() - post0
     return traj
-
-
-def _centre_depth(pose: tuple, flat: bool) -> float:
-    """Mean contact gap from PyBullet's pose ((x, y, z), (qx, qy, qz, qw)), in plain floats.
-
-    flat: the mean of the vertex gaps z + (R r_k)_z is z (Σ r_k = 0).  three_point: the
-    mean of (x − b_k)·e3 is x·e3 (Σ b_k = 0), e3 = R ẑ.  NaN stays NaN."""
-    (x, y, z), (qx, qy, qz, qw) = pose
-    if flat:
-        return z
-    return (
-        x * 2.0 * (qx * qz + qw * qy)
-        + y * 2.0 * (qy * qz - qw * qx)
-        + z * (1.0 - 2.0 * (qx * qx + qy * qy))
-    )
 
 
 def _states(rows: list[tuple]) -> np.ndarray:

@@ -50,6 +50,8 @@ def engine_versions() -> dict[str, str]:
     """{distribution: version} of every installed engine's registering package and of
     the physics library its entry point says it wraps.  An engine whose entry point does
     not load contributes its package only."""
+    from engines.interface import attribute
+
     from .simulators import EngineLoadError, engine_infos, load_engine
 
     out: dict[str, str] = {}
@@ -57,7 +59,7 @@ def engine_versions() -> dict[str, str]:
         if info.package and info.version:
             out[info.package] = info.version
         try:
-            library = getattr(load_engine(info.name), "library", None)
+            library = attribute(load_engine(info.name), "library")
         except EngineLoadError:
             continue
         version = distribution_version(library)

@@ -21,6 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import metadata
 
+from engines.interface import attribute
 from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
@@ -76,7 +77,7 @@ def _loaded(name: str) -> Callable:
         ) from None
     if not callable(obj):
         raise EngineLoadError(f"engine {name!r} ({info.target}) is not callable")
-    fixed = getattr(obj, "fixed_step", True)
+    fixed = attribute(obj, "fixed_step")
     if not isinstance(fixed, bool):
         raise EngineLoadError(
             f"engine {name!r} ({info.target}): fixed_step must be True or False, got {fixed!r}"
@@ -110,7 +111,7 @@ def load_engine(name: str) -> Callable:
 
 def is_fixed_step(name: str) -> bool:
     """Whether `--dt` applies to the simulator (its `fixed_step` attribute, default True)."""
-    return bool(getattr(load_engine(name), "fixed_step", True))
+    return bool(attribute(load_engine(name), "fixed_step"))
 
 
 def check_engine(name: str) -> str:
@@ -142,7 +143,7 @@ def run_simulator(
     simulate = load_engine(engine)
     step = check_run(engine, scene, dt, t_end, max_steps)
     extra = {}
-    if progress is not None and getattr(simulate, "reports_progress", False):
+    if progress is not None and attribute(simulate, "reports_progress"):
         extra["progress"] = progress
     try:
         traj = simulate(scene, dt=step, t_end=t_end, **extra)
@@ -189,7 +190,7 @@ def check_run(
         raise SceneError(f"--dt must be > 0, got {dt}")
     if t_end is not None:
         scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
-    limit = getattr(simulate, "max_vertices", None)
+    limit = attribute(simulate, "max_vertices")
     if limit is not None and scene.body.n > limit:
         raise SceneError(
             f"engine {engine!r} takes polygons of at most {limit} vertices, got n = {scene.body.n}"

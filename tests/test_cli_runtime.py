@@ -43,10 +43,10 @@ def test_ctrl_c_stops_mujoco_and_keeps_the_whole_chunks_done(monkeypatch):
 
 
 def test_ctrl_c_stops_pybullet_and_keeps_the_steps_read(monkeypatch):
-    monkeypatch.setattr(PB, "PROGRESS_EVERY", 50)
-    stop = StopAt(2)  # raised at step 100
+    monkeypatch.setattr(PB, "CHUNK_STEPS", 50)
+    stop = StopAt(3)  # called before chunks 0, 1, 2: raised after step 100
     traj = PB.simulate_pybullet(make_scene(n=3, t_end=0.05), 1e-4, progress=stop)
-    assert stop.calls == [50, 100]
+    assert stop.calls == [0, 50, 100]
     assert traj.status.value == "failed" and traj.stats["interrupted"]
     assert 0 < traj.t[-1] < 0.0101 and np.isfinite(traj.energy).all()
 

@@ -22,6 +22,8 @@ def engine_rows() -> list[dict]:
     distribution that registers it), fixed_step and library (the optional `library`
     attribute: the physics engine's distribution) with its version (None when it does not
     load), and the load error (None when it loads)."""
+    from engines.interface import attribute
+
     from ..provenance import distribution_version
     from ..simulators import EngineLoadError, engine_infos, is_fixed_step, load_engine
 
@@ -39,7 +41,7 @@ def engine_rows() -> list[dict]:
         }
         try:
             row["fixed_step"] = is_fixed_step(info.name)
-            row["library"] = getattr(load_engine(info.name), "library", None)
+            row["library"] = attribute(load_engine(info.name), "library")
             row["library_version"] = distribution_version(row["library"])
         except EngineLoadError as exc:
             row["error"] = str(exc)
