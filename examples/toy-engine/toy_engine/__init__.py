@@ -2,10 +2,14 @@
 every vertex a one-step velocity projection (Newton's law vₙ⁺ = −γ vₙ⁻ on contacts that
 penetrate and approach, solved one contact at a time, Gauss–Seidel).
 
-It shows what an engine adapter does: build the scene's body (from the harness's
-`engines.base` helpers), step it, and hand per-step states (reference conventions: x,
-q wxyz, v, ω world) and per-contact normal impulses to `build_trajectory`, which finds the
-impacts (contact onsets), energies and the impact budget.  Flat ground only.
+It shows what an engine adapter does (docs/engines.md): build the scene's body (from the
+harness's `engines.base` helpers); wrap the stepping in a Stepper (`ToyStepper`) that the
+harness's run loop `engines.stepping.run_steps` drives (progress, checks for a
+non-finite state or a fall-through, Ctrl-C); hand the per-step states (reference
+conventions: x, q wxyz, v, ω world) and per-contact normal impulses to
+`build_trajectory`, which finds the impacts (contact onsets), energies and the impact
+budget; declare the entry point's attributes with `engines.interface.engine_entry`.
+Flat ground only.
 """
 
 from __future__ import annotations
@@ -13,11 +17,14 @@ from __future__ import annotations
 import numpy as np
 
 from engines.base import build_trajectory, initial_state, scene_points
+from engines.interface import engine_entry
+from engines.stepping import Rows, run_steps
 from reference.scene import Scene, SceneError
-from reference.trajectory import Status, Trajectory
+from reference.trajectory import Trajectory
 
 __version__ = "0.1.0"
 GAUSS_SEIDEL_SWEEPS = 4  # resting n-gons need a few sweeps to share the load
+CHUNK_STEPS = 1_000  # steps between two checks (and progress reports) of the run loop
 
 
 def _rotation(q):
@@ -72,26 +79,57 @@ def _step(y, dt, g, m, inertia, points, gamma):
     return np.concatenate([x + dt * v, _rotate_by(q, w * dt), v, w]), impulses
 
 
-def simulate(scene: Scene, *, dt: float, t_end: float | None = None) -> Trajectory:
-    """The entry point: `harness` calls it with the scene, the step and the end time."""
+class ToyStepper:
+    """The engine as an `engines.stepping.Stepper`: the shared run loop calls `advance`
+    chunk by chunk and checks the rows it returns (non-finite state, fall-through),
+    calls `cut` when a row fails, `settle` after Ctrl-C."""
+
+    def __init__(self, scene: Scene, dt: float) -> None:
+        self.dt, self.g = dt, scene.gravity
+        self.m, self.gamma = scene.body.mass, scene.restitution
+        self.points = scene_points(scene)
+        self.inertia = np.array(scene.body.inertia_diag)
+        self.states = [initial_state(scene.initial)]  # row j: the state after step j
+        self.impulses = [np.zeros(len(self.points))]  # row j: applied in step j
+        self.first = 0
+
+    def advance(self, steps: int) -> Rows:
+        self.first = len(self.states)
+        for _ in range(steps):
+            y, p = _step(
+                self.states[-1], self.dt, self.g, self.m, self.inertia, self.points, self.gamma
+            )
+            self.states.append(y)
+            self.impulses.append(p)
+        t = self.dt * np.arange(self.first, len(self.states))
+        return Rows(t, np.array(self.states[self.first :]))
+
+    def cut(self, keep: int) -> None:
+        del self.states[self.first + keep :], self.impulses[self.first + keep :]
+
+    def settle(self) -> float:
+        kept = min(len(self.states), len(self.impulses))
+        del self.states[kept:], self.impulses[kept:]
+        return self.dt * (kept - 1)
+
+
+@engine_entry(fixed_step=True, reports_progress=True)
+def simulate(scene: Scene, *, dt: float, t_end: float | None = None, progress=None) -> Trajectory:
+    """The entry point: `harness` calls it with the scene, the step and the end time (and
+    a progress callback, since it says `reports_progress`)."""
     if scene.ground.kind != "flat":
         raise SceneError("the toy engine models flat ground only")
     t_end = scene.run.t_end if t_end is None else float(t_end)
     n = max(1, int(round(t_end / dt)))
-    points = scene_points(scene)
-    inertia = np.array(scene.body.inertia_diag)
-    states = np.empty((n + 1, 13))
-    impulses = np.zeros((n + 1, len(points)))
-    states[0] = initial_state(scene.initial)
-    for j in range(n):
-        states[j + 1], impulses[j + 1] = _step(
-            states[j], dt, scene.gravity, scene.body.mass, inertia, points, scene.restitution
-        )
-    t = dt * np.arange(n + 1)
-    stats = {"steps": n, "toy_engine_version": __version__}
-    return build_trajectory(
-        scene, "toy", dt, t, states, impulses, Status.T_END, f"reached t_end = {t_end:g}", stats
-    )
-
-
-simulate.fixed_step = True  # --dt applies
+    stepper = ToyStepper(scene, dt)
+    loop = run_steps(stepper, scene, n, CHUNK_STEPS, progress, t_end=t_end)
+    states, impulses = np.array(stepper.states), np.array(stepper.impulses)
+    t = dt * np.arange(len(states))
+    stats = {
+        "steps": len(states) - 1,
+        "steps_per_s": (len(states) - 1) / loop.stepping_s if loop.stepping_s > 0 else None,
+        "toy_engine_version": __version__,
+    }
+    if loop.interrupted:
+        stats["interrupted"] = True
+    return build_trajectory(scene, "toy", dt, t, states, impulses, loop.status, loop.message, stats)
