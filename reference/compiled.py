@@ -5,24 +5,21 @@ just-in-time compilation with its on-disk cache.
 compiler needed) into an extension module beside the sources; it imports in
 milliseconds and needs no numba at run time.  A stamp of the core's source files is
 stored with it: when the sources change, the stale module is ignored and the loop is
-compiled just in time (cached in __pycache__ after the first run).  `warm_up` does the
-one-time work (compilation, or loading the cache) apart, so that run times never
-include it, and says so on stderr the first time it compiles."""
+compiled just in time (cached in __pycache__ after the first run).
+`reference.simulate.load_event_loop` does the one-time work (compilation, or loading the
+cache) apart, so that run times never include it.  This module imports no other module of
+the package (reference.geometry imports it)."""
 
 from __future__ import annotations
 
 import hashlib
 import importlib
 import os
-import sys
-import time
 from pathlib import Path
 
 CORE_DIR = Path(__file__).with_name("core")
 AOT_MODULE = "reference.core._aot"
 STAMP_FILE = CORE_DIR / "_aot.stamp"
-# A rough cost of compiling the loop just in time on a 2-core machine (measured).
-JIT_COMPILE_ESTIMATE_S = 60
 
 # exported function → the core module that defines it
 EXPORTS = {
@@ -42,7 +39,6 @@ EXPORTS = {
 _aot = None
 _aot_checked = False
 _cache_checked = False
-_warm = False
 
 
 def source_stamp() -> str:
@@ -134,29 +130,6 @@ def kernel_source() -> str:
     return "ahead-of-time" if _aot_module() is not None else "just-in-time"
 
 
-def _jit_cached() -> bool:
+def jit_cached() -> bool:
     """Whether numba's cache holds the loop already (its index file exists)."""
     return any((CORE_DIR / "__pycache__").glob("loop.run_events-*.nbi"))
-
-
-def warm_up() -> float:
-    """Compile or load the event loop once per process (a tiny run); returns the seconds
-    it took (0 when already warm).  The first compilation on a machine is announced on
-    stderr with its rough duration."""
-    global _warm
-    if _warm:
-        return 0.0
-    t0 = time.perf_counter()
-    kernel = run_events()
-    if kernel_source() == "just-in-time" and not _jit_cached():
-        print(
-            f"reference: compiling the event loop (first run on this machine, about "
-            f"{JIT_COMPILE_ESTIMATE_S} s; `make setup` builds it ahead of time)",
-            file=sys.stderr,
-            flush=True,
-        )
-    from .simulate import tiny_run
-
-    tiny_run(kernel)
-    _warm = True
-    return time.perf_counter() - t0

@@ -27,7 +27,7 @@ import numpy as np
 from .compiled import function
 from .quaternion import from_rotation_vector
 
-if TYPE_CHECKING:  # geometry depends on no other module of the package
+if TYPE_CHECKING:  # at run time geometry imports only compiled and quaternion
     from .scene import Body, Ground, InitialState, Scene
 
 

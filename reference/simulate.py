@@ -10,6 +10,7 @@ reference.core.
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,7 +31,7 @@ from .core.records import (
 from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
-from .scene import Scene
+from .scene import Scene, scene_from_dict
 from .stats import RunStats
 from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
 
@@ -211,7 +212,7 @@ def simulate(
     (every `options.work_budget` steps).  stats.wall_time_s is the run alone;
     stats.compile_s the one-time compilation or loading that preceded it."""
     opts = options or ReferenceOptions()
-    compile_s = compiled.warm_up()
+    compile_s = load_event_loop()
     t_end = float(t_end if t_end is not None else scene.run.t_end)
     problem = make_problem(scene, t_end, opts)
     kernel = compiled.run_events()
@@ -221,10 +222,34 @@ def simulate(
     return _trajectory(scene, problem, opts, t_end, wall, compile_s)
 
 
-def tiny_run(kernel) -> None:
-    """A run of a few events, to compile or load the loop (compiled.warm_up)."""
-    from .scene import scene_from_dict
+# A rough cost of compiling the loop just in time on a 2-core machine (measured).
+JIT_COMPILE_ESTIMATE_S = 60
+_event_loop_loaded = False
 
+
+def load_event_loop() -> float:
+    """Compile or load the event loop once per process (a tiny run); returns the seconds
+    it took (0 when already done).  The first compilation on a machine is announced on
+    stderr with its rough duration."""
+    global _event_loop_loaded
+    if _event_loop_loaded:
+        return 0.0
+    t0 = time.perf_counter()
+    kernel = compiled.run_events()
+    if compiled.kernel_source() == "just-in-time" and not compiled.jit_cached():
+        print(
+            f"reference: compiling the event loop (first run on this machine, about "
+            f"{JIT_COMPILE_ESTIMATE_S} s; `make setup` builds it ahead of time)",
+            file=sys.stderr,
+            flush=True,
+        )
+    tiny_run(kernel)
+    _event_loop_loaded = True
+    return time.perf_counter() - t0
+
+
+def tiny_run(kernel) -> None:
+    """A run of a few events, to compile or load the loop (`load_event_loop`)."""
     scene = scene_from_dict(
         {
             "body": {"n": 3},
