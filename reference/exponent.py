@@ -26,7 +26,7 @@ Definition (Baranyai & Várkonyi, eq. scalinglaw, sections 3.4, 4.3):
   energy make a slope error of 0.1 a residual of more than half a decade.
 - **Only runs that reach the end of the motion** have a c: status singularity (t_f is the
   run's t_singularity), or a run that followed a reference to its singularity (the
-  caller passes the reference's t_f; harness.metrics.exponent decides).  A run stopped
+  caller passes the reference's t_f; harness.metrics.run_exponent decides).  A run stopped
   by an undecidable impact, a budget or t_end has no t_f, and the paper records no c
   for it either.
 
@@ -34,7 +34,7 @@ Time to go is summed from the intervals between impacts, smallest first (`time_t
 each interval from the (t, t_lo) double-double parts, so it keeps its relative precision
 however close to t_f.  Runs can span hundreds of decades (gravity-free chatter with small
 c), so the linear model works in log2 of intervals and energies (`extrapolate_time_to_go`,
-reference.linear.exponent.exponent_of_run) and both end in `regress_in_window`.
+reference.linear.exponent_estimates.exponent_of_run) and both end in `regress_in_window`.
 """
 
 from __future__ import annotations

@@ -63,7 +63,7 @@ def test_rod_cc_property_is_goyal_condition():
 def test_gravity_free_rod_chatter_has_exponent_c_lin(rho, gamma):
     m = LinearModel.polygon(2, rho, gamma, gravity=0.0)
     run = run_linear(m, [0.0, 0.01, 0.05], [0.0, 0.1, -1.0], energy_floor=1e-40)
-    from reference.linear.exponent import exponent_of_run
+    from reference.linear.exponent_estimates import exponent_of_run
 
     ex = exponent_of_run(run)
     cl = analyze_chatter(2, rho, gamma)["c_lin"]

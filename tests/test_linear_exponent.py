@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from reference.linear.exponent import (
+from reference.linear.exponent_estimates import (
     exponent_from_decades,
     exponent_of_run,
     extrapolate_time_to_go,

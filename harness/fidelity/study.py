@@ -33,7 +33,7 @@ from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
 from ..bench import predict_time
-from ..metrics import evaluate
+from ..metrics import evaluate, run_exponent
 from ..progress import progress_bar
 from ..simulators import engine_names, is_fixed_step, run_simulator, warm_up
 from ..stress.budget import (
@@ -45,7 +45,6 @@ from ..stress.budget import (
     timed,
 )
 from .criteria import FidelityCriteria, alpha_star, exponent_check, impacts_pass, power_law_fit
-from .exponent import exponent_of
 from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
 from .settings import DEFAULT_BUDGET_S, DEFAULT_DTS, DEFAULT_EPS_GRID, WINDOWS
 
@@ -136,7 +135,7 @@ def scale_case(scene: Scene, eps: float, criteria: FidelityCriteria) -> ScaleCas
         lead,
         inclination_scale(ref, lead.t_last),
         alpha0,
-        exponent_of(ref, scaled),
+        run_exponent(ref, scaled),
     )
 
 
@@ -150,7 +149,10 @@ def score(traj: Trajectory, case: ScaleCase, criteria: FidelityCriteria) -> dict
     in_leading = np.isin(pairs[:, 0], case.leading.indices)
     matched = int(in_leading.sum())
     t_err = float(np.max(np.abs(m.match.time_errors[in_leading]))) if matched else None
-    fit = exponent_of(traj, case.scene, case.reference, m.match)
+    # c by the project's one estimator; a run has one only where it reached the end of the
+    # motion (its own singularity, or the reference's when it followed it there), so a
+    # fixed-step engine cut at the leading impacts has none (`--window whole` needed)
+    fit = run_exponent(traj, case.scene, case.reference, m.match)
     ref_fit = case.exponent
     c_ok, c_why = exponent_check(fit.c, ref_fit.c, criteria, fit.reason, ref_fit.reason)
     impacts_ok = impacts_pass(matched, case.leading.n, criteria)

@@ -29,7 +29,7 @@ def fig_energy_precession(out: Path, progress) -> dict:
     fig, axes = plt.subplots(3, 2, figsize=(10, 10))
     cs = []
     from reference.linear import kernel as K
-    from reference.linear.exponent import exponent_of_run
+    from reference.linear.exponent_estimates import exponent_of_run
 
     for ax, (n, g) in zip(axes.flat, cases, strict=True):
         progress(f"  energy_precession n={n} gamma={g}")

@@ -38,7 +38,6 @@ from .attitude import (  # noqa: F401  (the package's API)
     largest_tilt,
 )
 from .energy import ENERGY_GUARD_STEPS, energy_error, energy_error_series  # noqa: F401
-from .exponent import followed_to_singularity, run_exponent  # noqa: F401
 from .matching import (  # noqa: F401
     EVENT_TIME_TOLERANCE,
     RELATIVE_TIME_TOLERANCE,
@@ -58,6 +57,7 @@ from .matching import (  # noqa: F401
     slow_impact_speed,
 )
 from .restitution import RestitutionEstimate, effective_restitution  # noqa: F401
+from .run_exponent import followed_to_singularity, run_exponent  # noqa: F401
 
 # ----------------------------------------------------------------------------- all of them
 

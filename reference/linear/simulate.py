@@ -248,7 +248,7 @@ def simulate_linear(
     exponent.extrapolate_time_to_go), t_end, max_impacts.  Chatter sequences are
     completed in closed form (kernel.py); they are listed in stats["accumulations"], not
     as impacts."""
-    from .exponent import extrapolate_time_to_go
+    from .exponent_estimates import extrapolate_time_to_go
 
     model = LinearModel.from_scene(scene)
     q0, p0 = linear_state(scene)
@@ -390,7 +390,7 @@ def run_linear_exponent(
     c_stderr, t_singularity (None unless the singularity was reached), n_impacts, and
     the cross-check estimates c_decades (durations of energy decades, no t_f needed) and
     c_period (ratios over one period of a periodic impact pattern, when there is one)."""
-    from .exponent import exponent_of_run
+    from .exponent_estimates import exponent_of_run
 
     base = {
         "status": Status.FAILED.value,
