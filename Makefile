@@ -3,8 +3,10 @@ PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
-# the reference's compiled core, built ahead of time (skipped without a C compiler: it is
-# then compiled just in time on first use); rebuilt when its sources change
+# the reference's compiled core, built ahead of time by the package's own build step
+# (setup.py, during `pip install -e`; skipped without a C compiler: it is then compiled just
+# in time on first use); `python -m reference.core.aot` rebuilds it when its sources
+# change and does nothing when it is fresh
 AOT    := $(VENV)/.aot
 CORE   := $(wildcard reference/core/*.py)
 
@@ -51,4 +53,4 @@ browser:
 	@command -v chromium >/dev/null 2>&1 || { apt-get update && apt-get install -y chromium; }
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache reference/core/_aot*
+	rm -rf $(VENV) .pytest_cache .ruff_cache build reference/core/_aot*
