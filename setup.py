@@ -35,7 +35,7 @@ class BuildCompiledCore(build_ext):
         from reference.compiled import STAMP_FILE
 
         built = Path(self.get_ext_fullpath(CORE_MODULE)).parent / STAMP_FILE.name
-        if built.exists():
+        if built.exists() and built.resolve() != STAMP_FILE.resolve():
             shutil.copyfile(built, STAMP_FILE)
 
 
