@@ -1,7 +1,9 @@
 """Simulator registry: every engine is an entry point in the group `harness.engines`.
 
-An entry point names a callable `simulate(scene, *, dt, t_end) -> Trajectory`; its
-attribute `fixed_step` (default True) says whether `--dt` applies.  This package registers
+An entry point names an `engines.interface.Engine`: a callable `simulate(scene, *, dt,
+t_end) -> Trajectory` whose optional attributes (`fixed_step`, `library`,
+`max_vertices`, `reports_progress`) are read with their defaults by
+`engines.interface.attribute`.  This package registers
 its own engines the same way (pyproject.toml), so nothing here names an engine and an
 engine installed from another package is used exactly like a built-in one
 (docs/engines.md).
