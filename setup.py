@@ -15,7 +15,7 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 ROOT = Path(__file__).resolve().parent
-CORE_MODULE = "reference.core._aot"
+CORE_MODULE = "reference.core._aot"  # reference.compiled.AOT_MODULE
 
 
 class BuildCompiledCore(build_ext):
@@ -26,17 +26,18 @@ class BuildCompiledCore(build_ext):
             sys.path.insert(0, str(ROOT))  # the sources being built, not an installed copy
         from reference.core import aot
 
-        aot.build_or_explain(Path(self.get_ext_fullpath(ext.name)).parent)
+        self.built_core = aot.build_or_explain(Path(self.get_ext_fullpath(ext.name)).parent)
 
     def copy_extensions_to_source(self) -> None:
-        """An editable install (`pip install -e .`) uses the sources in place: the stamp
-        goes beside the module."""
+        """An editable install (`pip install -e .`) uses the sources in place: setuptools
+        copies the module there, and the stamp goes beside it."""
         super().copy_extensions_to_source()
         from reference.compiled import STAMP_FILE
 
-        built = Path(self.get_ext_fullpath(CORE_MODULE)).parent / STAMP_FILE.name
-        if built.exists() and built.resolve() != STAMP_FILE.resolve():
-            shutil.copyfile(built, STAMP_FILE)
+        built = getattr(self, "built_core", None)
+        stamp = built.with_name(STAMP_FILE.name) if built is not None else None
+        if stamp is not None and stamp.resolve() != STAMP_FILE.resolve():
+            shutil.copyfile(stamp, STAMP_FILE)
 
 
 setup(
