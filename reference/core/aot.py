@@ -47,14 +47,17 @@ def signatures() -> dict:
 
 def build(output_dir: Path = CORE_DIR) -> Path:
     """Compile the module into output_dir and write its stamp there; returns the
-    module's path."""
+    module's path.  Any module already there goes first: a failed build leaves none (of
+    older sources) behind."""
+    from reference.compiled import STAMP_FILE, jit_function, source_stamp
+
+    output_dir.mkdir(parents=True, exist_ok=True)
+    for old in [*output_dir.glob("_aot*.so"), output_dir / STAMP_FILE.name]:
+        old.unlink(missing_ok=True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pycc announces its pending deprecation
         from numba.pycc import CC
 
-    from reference.compiled import STAMP_FILE, jit_function, source_stamp
-
-    output_dir.mkdir(parents=True, exist_ok=True)
     cc = CC("_aot")
     cc.output_dir = str(output_dir)
     cc.verbose = False
@@ -74,8 +77,9 @@ def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
     try:
         path = build(output_dir)
     except Exception as exc:  # any failure: the loop is compiled just in time instead
-        print(f"ahead-of-time build skipped ({type(exc).__name__}: {exc}); the loop will be "
-              "compiled just in time on first use", file=sys.stderr)  # fmt: skip
+        reason = " ".join(f"{type(exc).__name__}: {exc}".split())  # one line
+        print(f"ahead-of-time build skipped ({reason}); the loop will be compiled just in "
+              "time on first use", file=sys.stderr)  # fmt: skip
         return None
     print(f"built {path.name} in {time.perf_counter() - t0:.0f} s", flush=True)
     return path
