@@ -17,12 +17,15 @@ OUTCOME_CODES = {"ok": None, "no contact": "none", "no separation": "stuck"}
 
 def format_restitution(doc: dict) -> str:
     g = doc["grid"]
-    lines = [
+    head = (
         f"harness restitution: single impacts, e_eff = -u+/u- against gamma; faithful: "
-        f"|e_eff/gamma - 1| <= {100 * doc['faithful']:g} %",
+        f"|e_eff/gamma - 1| <= {100 * doc['faithful']:g} %"
+    )
+    grid = (
         f"grid: gamma {_values(g['gamma'])}; impact speed {_values(g['speed'])} sqrt(g a); "
-        f"dt {_values(g['dt'])}; geometry {', '.join(g['geometry'])}",
-    ]
+        f"dt {_values(g['dt'])}; geometry {', '.join(g['geometry'])}"
+    )
+    lines = [*textwrap.wrap(head, WIDTH), *textwrap.wrap(grid, WIDTH, subsequent_indent="  ")]
     for e in doc["engines"]:
         lines += ["", *engine_text(e, g)]
     lines += ["", *legend()]
@@ -66,6 +69,8 @@ def _groups(rows: list[dict], grid: dict):
 def _cell(r: dict | None) -> str:
     if r is None:
         return ""
+    if r["outcome"].startswith("run failed"):
+        return "fail"
     if r["outcome"] != "ok" or r["e_error"] is None:
         return OUTCOME_CODES.get(r["outcome"]) or "n/a"
     return percent(r["e_error"])
@@ -117,7 +122,8 @@ def _range(r: list[float] | None) -> str:
 def legend() -> list[str]:
     return textwrap.wrap(
         "Columns: e_eff/gamma - 1 [%] at each impact speed u- [sqrt(g a)] (stuck: did not "
-        "leave the ground; none: never touched; n/a: the run ended otherwise); dE/dEx-1: the "
+        "leave the ground; none: never touched; fail: the run failed; n/a: the model stops "
+        "there, e.g. the reference at a simultaneous impact); dE/dEx-1: the "
         "worst energy change against the exact loss (1 - gamma^2) u-^2/(2w); gain: impacts "
         "that gained energy; pen/a: deepest penetration; t_c: longest contact [sqrt(a/g)].",
         WIDTH,
