@@ -108,7 +108,7 @@ def tuned_contact(gamma: float, dt: float) -> ContactSettings:
     contact sinks at (1 − d) g h/(1 + γ), i.e. 1e-4 g h² per step: 3e-8 over 3 s at
     h = 1e-4.  d = 1 − 1e-4 is MuJoCo's largest impedance (mjMAXIMP).  Measured with
     `harness restitution --engine mujoco` (single vertex drop, γ = 0.3…0.95,
-    h = 1e-3…1e-5): see the table in that module's docstring.
+    h = 1e-3…1e-5): see docs/engines.md, "The restitution contract".
 
     Integrator: Euler, MuJoCo's semi-implicit (symplectic) Euler, for which the one-step
     damper is exact and whose velocities we read at half steps (leapfrog; see

@@ -124,3 +124,20 @@ def test_text_fits_100_columns():
     doc = run_study(["reference"], Grid(gammas=(0.5,), speeds=(0.1,), geometries=("vertex",)))
     doc["grid"] = grid.to_dict()
     assert max(len(line) for line in format_restitution(doc).splitlines()) <= 100
+
+
+def test_report_has_a_restitution_section_with_escaped_text(tmp_path):
+    """The HTML report reads the command's JSON (kind "restitution"): the engine's table,
+    its faithful range and figure; strings from the document are escaped."""
+    grid = Grid(gammas=(0.5,), speeds=(0.1, 1.0), dts=(1e-4,), geometries=("vertex", "edge"))
+    doc = run_study(["reference"], grid)
+    doc["engines"][0]["mapping"] = "<b>damper</b> & co"
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps(doc))
+    out = tmp_path / "r.html"
+    assert main(["report", str(path), "--out", str(out)]) == 0
+    html = out.read_text()
+    assert "restitution" in html and "faithful range" in html
+    assert "&lt;b&gt;damper&lt;/b&gt; &amp; co" in html and "<b>damper" not in html
+    assert "data:image/png;base64," in html
+    assert "simultaneous_impact" in html  # the reference's edge, shown as such

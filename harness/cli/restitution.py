@@ -36,9 +36,7 @@ def register(sub) -> None:
         "timesteps, with the energy change against the exact loss, penetration and contact "
         "time, and the range where |e_eff/gamma - 1| <= 1 %.",
     )
-    add_engine(
-        p, many="default: reference and every installed fixed-step engine that loads"
-    )
+    add_engine(p, many="default: reference and every installed fixed-step engine that loads")
     p.add_argument(
         "--gamma",
         type=requested_gamma,
@@ -51,14 +49,16 @@ def register(sub) -> None:
         type=impact_speed,
         action="append",
         metavar="V",
-        help=f"impact speed in sqrt(g a), in [1e-6, 100]; repeat (default: {_list(DEFAULT_SPEEDS)})",
+        help="impact speed in sqrt(g a), in [1e-6, 100]; repeat "
+        f"(default: {_list(DEFAULT_SPEEDS)})",
     )
     p.add_argument(
         "--dt",
         type=study_timestep,
         action="append",
         metavar="DT",
-        help=f"timestep of fixed-step engines in [1e-6, 1e-2]; repeat (default: {_list(DEFAULT_DTS)})",
+        help="timestep of fixed-step engines in [1e-6, 1e-2]; repeat "
+        f"(default: {_list(DEFAULT_DTS)})",
     )
     p.add_argument(
         "--geometry",
@@ -84,7 +84,7 @@ def _list(xs) -> str:
 def run(args) -> int:
     from ..progress import progress_counter
     from ..provenance import attach
-    from ..restitution.study import Grid, run_study
+    from ..restitution.study import run_study
     from ..restitution.text import format_restitution
 
     engines = study_engines(args.engine)
@@ -96,7 +96,6 @@ def run(args) -> int:
     attach(doc, args)
     write_outputs(args, doc, plots)
     emit(doc, args.json, format_restitution(doc))
-    assert isinstance(grid, Grid)
     return 0
 
 

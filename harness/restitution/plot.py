@@ -54,7 +54,9 @@ def _legend(fig, ax, dts, gammas) -> None:
     from matplotlib.lines import Line2D
 
     handles = [
-        Line2D([], [], color=f"C{i}", lw=2, label="exact (event-driven)" if d is None else f"dt {d:g}")
+        Line2D(
+            [], [], color=f"C{i}", lw=2, label="exact (event-driven)" if d is None else f"dt {d:g}"
+        )
         for i, d in enumerate(dts)
     ]
     handles += [

@@ -60,7 +60,9 @@ def _groups(rows: list[dict], grid: dict):
         for dt in dts:
             for gamma in grid["gamma"]:
                 group = [
-                    r for r in rows if r["geometry"] == geo and r["dt"] == dt and r["gamma"] == gamma
+                    r
+                    for r in rows
+                    if r["geometry"] == geo and r["dt"] == dt and r["gamma"] == gamma
                 ]
                 if group:
                     yield (geo, "-" if dt is None else f"{dt:.0e}", f"{gamma:g}"), group
