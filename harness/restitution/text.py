@@ -18,7 +18,7 @@ OUTCOME_CODES = {"ok": None, "no contact": "none", "no separation": "stuck"}
 def format_restitution(doc: dict) -> str:
     g = doc["grid"]
     head = (
-        f"harness restitution: single impacts, e_eff = -u+/u- against gamma; faithful: "
+        f"single impacts, e_eff = -u+/u- against gamma; faithful: "
         f"|e_eff/gamma - 1| <= {100 * doc['faithful']:g} %"
     )
     grid = (
