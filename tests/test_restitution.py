@@ -70,22 +70,35 @@ def test_edge_watches_the_midpoint_of_two_vertices_at_one_height():
 
 @pytest.mark.parametrize("engine", ["mujoco", "pybullet", "drake"])
 def test_engine_bounces_within_one_percent_at_dt_1e4_fast_impacts(engine):
-    """A fast vertex impact (u⁻ = 1) at dt = 1e-4: every adapter's mapping gives γ
-    within 1 %, loses energy (no gain) and penetrates for a finite time."""
+    """A fast vertex impact (u⁻ = 1) at dt = 1e-4, γ = 0.8, at the three default onset
+    phases: every adapter's mapping gives γ within 1 %, loses energy (no gain) and
+    penetrates for a finite time."""
     pytest.importorskip({"drake": "pydrake"}.get(engine, engine))
-    grid = Grid(gammas=(0.5,), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
-    (row,) = run_study([engine], grid)["engines"][0]["rows"]
-    assert row["outcome"] == "ok"
-    assert abs(row["e_error"]) <= 0.01
-    assert row["energy_change"] < 0 and not row["energy_gained"]
-    assert row["penetration"] > 0 and row["contact_time"] > 0
+    grid = Grid(gammas=(0.8,), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
+    rows = run_study([engine], grid)["engines"][0]["rows"]
+    assert len(rows) == 3
+    for row in rows:
+        assert row["outcome"] == "ok"
+        assert abs(row["e_error"]) <= 0.01
+        assert row["energy_change"] < 0 and not row["energy_gained"]
+        assert row["penetration"] > 0 and row["contact_time"] > 0
+
+
+def test_drake_sap_bounce_depends_on_the_onset_phase():
+    """SAP's mapping is exact at the middle phase; at γ = 0.3 (16-step contact) an onset
+    early in the step bounces more than γ and a late one less, by more than 1 %."""
+    pytest.importorskip("pydrake")
+    grid = Grid(gammas=(0.3,), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
+    rows = run_study(["drake"], grid)["engines"][0]["rows"]
+    err = {r["phase"]: r["e_error"] for r in rows}
+    assert err[0.1] > 0.01 and err[0.9] < -0.01 and abs(err[0.5]) < 0.01
 
 
 def test_mujoco_slow_impacts_lose_gamma_to_gravity_in_the_contact():
     """At u⁻ = g dt the one-step contact's gravity impulse is not small: MuJoCo's e_eff
     falls below γ by more than 1 % (what the contract's lower speed limit says)."""
     pytest.importorskip("mujoco")
-    grid = Grid(gammas=(0.5,), speeds=(1e-3,), dts=(1e-3,), geometries=("vertex",))
+    grid = Grid(gammas=(0.5,), speeds=(1e-3,), dts=(1e-3,), geometries=("vertex",), phases=(0.5,))
     (row,) = run_study(["mujoco"], grid)["engines"][0]["rows"]
     assert row["e_error"] < -0.01 and not row["faithful"]
 
@@ -108,7 +121,7 @@ def test_cli_json_plot_and_out(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     "bad", [["--gamma", "0"], ["--gamma", "1.5"], ["--speed", "-1"], ["--dt", "0.5"],
-            ["--geometry", "corner"], ["--engine", "nope"]],
+            ["--phase", "0"], ["--geometry", "corner"], ["--engine", "nope"]],
 )  # fmt: skip
 def test_cli_bad_input_is_one_line_and_exit_2(bad, capsys, tmp_path):
     assert main(["restitution", *bad, "--out", str(tmp_path / "x.json")]) == 2

@@ -21,12 +21,13 @@ from .common import (
 requested_gamma = float_in(1e-6, 1.0, what="a restitution coefficient")
 impact_speed = float_in(1e-6, 1e2, what="an impact speed [sqrt(g a)]")
 study_timestep = float_in(1e-6, 1e-2, what="a timestep [sqrt(a/g)]")
+onset_phase = float_in(1e-3, 1.0, what="an onset phase [steps]")
 PLOT_NAME = "restitution-{engine}.png"
 
 
 def register(sub) -> None:
     from ..restitution.drops import GEOMETRIES
-    from ..restitution.study import DEFAULT_DTS, DEFAULT_GAMMAS, DEFAULT_SPEEDS
+    from ..restitution.study import DEFAULT_DTS, DEFAULT_GAMMAS, DEFAULT_PHASES, DEFAULT_SPEEDS
 
     p = sub.add_parser(
         "restitution",
@@ -59,6 +60,14 @@ def register(sub) -> None:
         metavar="DT",
         help="timestep of fixed-step engines in [1e-6, 1e-2]; repeat "
         f"(default: {_list(DEFAULT_DTS)})",
+    )
+    p.add_argument(
+        "--phase",
+        type=onset_phase,
+        action="append",
+        metavar="F",
+        help="onset phase in (0, 1]: the contact starts F*dt*speed above the ground, so it "
+        f"begins at that fraction of a step; repeat (default: {_list(DEFAULT_PHASES)})",
     )
     p.add_argument(
         "--geometry",
@@ -136,6 +145,7 @@ def study_grid(args):
         speeds=values(args.speed, defaults.speeds),
         dts=values(args.dt, defaults.dts),
         geometries=values(args.geometry, defaults.geometries),
+        phases=values(args.phase, defaults.phases),
     )
 
 

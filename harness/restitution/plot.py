@@ -1,5 +1,6 @@
 """One figure per engine: e_eff/γ − 1 against the impact speed, a panel per geometry, a
-colour per dt and a marker per γ, the faithful band |e_eff/γ − 1| ≤ 1 % shaded."""
+colour per dt and a marker per γ, the faithful band |e_eff/γ − 1| ≤ 1 % shaded.  The line
+goes through the worst onset phase of each cell (as the table), a bar spans all phases."""
 
 from __future__ import annotations
 
@@ -27,18 +28,12 @@ def restitution_figure(engine_doc: dict, grid: dict, faithful: float):
         ax.axhline(0.0, color="0.4", lw=0.8)
         for i, dt in enumerate(dts):
             for j, gamma in enumerate(grid["gamma"]):
-                pts = sorted(
-                    (r["speed"], 100.0 * r["e_error"])
-                    for r in rows
-                    if r["geometry"] == geo
-                    and r["dt"] == dt
-                    and r["gamma"] == gamma
-                    and r["outcome"] == "ok"
-                    and r["e_error"] is not None
-                )
+                pts = _points(rows, geo, dt, gamma)
                 if pts:
-                    x, y = zip(*pts, strict=True)
-                    ax.plot(x, y, color=f"C{i}", marker=MARKERS[j % len(MARKERS)], ms=5, lw=1)
+                    x, y, lo, hi = (list(c) for c in zip(*pts, strict=True))
+                    style = {"color": f"C{i}", "marker": MARKERS[j % len(MARKERS)], "ms": 5}
+                    ax.plot(x, y, lw=1, **style)
+                    ax.vlines(x, lo, hi, color=f"C{i}", lw=2, alpha=0.5)
         ax.set_xscale("log")
         ax.set_yscale("symlog", linthresh=band, linscale=1.0)
         ax.set_title(geo)
@@ -48,6 +43,23 @@ def restitution_figure(engine_doc: dict, grid: dict, faithful: float):
     _legend(fig, axes[-1], dts, grid["gamma"])
     fig.suptitle(f"{engine_doc['engine']}: restitution against γ (grey: within ±{band:g} %)")
     return fig
+
+
+def _points(rows, geo, dt, gamma) -> list[tuple[float, float, float, float]]:
+    """(speed, worst, lowest, highest) of e_eff/γ − 1 [%] over the phases of each cell
+    that bounced in every phase."""
+    from .study import worst_row
+
+    out = []
+    cell = [r for r in rows if r["geometry"] == geo and r["dt"] == dt and r["gamma"] == gamma]
+    for v in sorted({r["speed"] for r in cell}):
+        at = [r for r in cell if r["speed"] == v]
+        worst = worst_row(at)
+        if worst is None or worst["outcome"] != "ok" or worst["e_error"] is None:
+            continue
+        errs = [100.0 * r["e_error"] for r in at]
+        out.append((v, 100.0 * worst["e_error"], min(errs), max(errs)))
+    return out
 
 
 def _legend(fig, ax, dts, gammas) -> None:

@@ -1,12 +1,15 @@
 """The restitution study as text: per engine, its γ mapping, a table of e_eff/γ − 1 by
-impact speed (rows: geometry, dt, γ) with the worst energy error, energy gains,
-penetration and contact time of each row, and its faithful range.  Lines stay within
+impact speed (rows: geometry, dt, γ; each cell the worst over the onset phases) with the
+worst energy error, energy gains, penetration and contact time of each row, and its
+faithful range.  Lines stay within
 WIDTH columns: with many speeds the speed columns are split into several tables."""
 
 from __future__ import annotations
 
 import math
 import textwrap
+
+from .study import worst_row
 
 WIDTH = 100
 KEY = "{:<6} {:>6} {:>5}"  # geometry, dt, gamma
@@ -23,7 +26,8 @@ def format_restitution(doc: dict) -> str:
     )
     grid = (
         f"grid: gamma {_values(g['gamma'])}; impact speed {_values(g['speed'])} sqrt(g a); "
-        f"dt {_values(g['dt'])}; geometry {', '.join(g['geometry'])}"
+        f"dt {_values(g['dt'])}; onset phase {_values(g.get('phase', []))} of a step; "
+        f"geometry {', '.join(g['geometry'])}"
     )
     lines = [*textwrap.wrap(head, WIDTH), *textwrap.wrap(grid, WIDTH, subsequent_indent="  ")]
     for e in doc["engines"]:
@@ -48,8 +52,9 @@ def _table(e: dict, grid: dict, speeds: list[float], extras: bool) -> list[str]:
     head = KEY.format("geom", "dt", "gamma") + "".join(f"{_speed(v):>{CELL}}" for v in speeds)
     lines = [head + (EXTRAS_HEAD if extras else "")]
     for key, rows in _groups(e["rows"], grid):
-        by_speed = {r["speed"]: r for r in rows}
-        cells = "".join(f"{_cell(by_speed.get(v)):>{CELL}}" for v in speeds)
+        cells = "".join(
+            f"{_cell(worst_row([r for r in rows if r['speed'] == v])):>{CELL}}" for v in speeds
+        )
         lines.append(KEY.format(*key) + cells + (_extras(rows) if extras else ""))
     return lines
 
@@ -123,7 +128,8 @@ def _range(r: list[float] | None) -> str:
 
 def legend() -> list[str]:
     return textwrap.wrap(
-        "Columns: e_eff/gamma - 1 [%] at each impact speed u- [sqrt(g a)] (stuck: did not "
+        "Columns: e_eff/gamma - 1 [%] at each impact speed u- [sqrt(g a)], the worst over "
+        "the onset phases (stuck: did not "
         "leave the ground; none: never touched; fail: the run failed; n/a: the model stops "
         "there, e.g. the reference at a simultaneous impact); dE/dEx-1: the "
         "worst energy change against the exact loss (1 - gamma^2) u-^2/(2w); gain: impacts "
