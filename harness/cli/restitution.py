@@ -17,7 +17,8 @@ from .common import (
 )
 
 # The ranges the command accepts (docs/inputs.md): γ > 0 (e_eff/γ), speeds in √(g a),
-# and steps from 1e-6 (MAX_CONTACT_TIME / dt stays within the step budget) to 1e-2.
+# and steps from 1e-6 (MAX_CONTACT_TIME / dt stays within the step budget) to 1e-2;
+# the onset phase in a step, from 1e-3 (a start at the ground itself is refused).
 requested_gamma = float_in(1e-6, 1.0, what="a restitution coefficient")
 impact_speed = float_in(1e-6, 1e2, what="an impact speed [sqrt(g a)]")
 study_timestep = float_in(1e-6, 1e-2, what="a timestep [sqrt(a/g)]")

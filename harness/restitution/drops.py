@@ -1,6 +1,7 @@
 """The single-impact scenes of the restitution study: a body without spin moving down at
-speed v₀ (in units of √(g a)), its watched contact half a step above the ground, so that
-it hits in the first step with normal speed ≈ v₀ and nothing else touches first.
+speed v₀ (in units of √(g a)), its watched contact `lead`·v₀ above the ground (lead: a
+fraction of a step, the onset phase), so that it hits in the first step with normal
+speed ≈ v₀ and nothing else touches first.
 
 Geometries (g = a = m = 1, ρ = ½, tilt θ = 0.1):
 
@@ -30,8 +31,9 @@ TILT = 0.1
 PENTAGON = {"n": 5, "radius": 1.0, "mass": 1.0, "gyration": 0.5}
 DISK = {"n": 64, "radius": 1.0, "mass": 1.0, "gyration": 0.5}
 BUMP_RADIUS = 0.5
-# The watched contact starts this many steps' travel above the ground: it hits within
-# the first step, so u⁻ is the initial normal speed (no fall under gravity first).
+# The default onset phase: the watched contact starts this many steps' travel above the
+# ground, so it hits within the first step and u⁻ is the initial normal speed (no fall
+# under gravity first).
 LEAD_STEPS = 0.5
 
 
