@@ -43,7 +43,7 @@ def _engine(e: dict[str, Any], grid: dict[str, Any], faithful: float) -> str:
                     rows.append(_row(geo, dt, gamma, group, speeds))
     header = ["geometry", "dt", "γ", *[f"u⁻ = {v:g}" for v in speeds]]
     caption = "e_eff/γ − 1 by impact speed [√(g a)], the worst over the onset phases"
-    header += ["worst ΔE/ΔE_exact − 1 where faithful", "energy gained", "penetration / a"]
+    header += ["ΔE/ΔE_exact − 1 (worst faithful)", "energy gained", "penetration / a"]
     header += ["contact time"]
     return (
         f"<h3>{esc(e['engine'])}</h3>"
