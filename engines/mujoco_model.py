@@ -108,8 +108,8 @@ def tuned_contact(gamma: float, dt: float) -> ContactSettings:
     penetration left by an onset stays (≤ |vₙ| h, the step's own error), and a resting
     contact sinks at (1 − d) g h/(1 + γ), i.e. 1e-4 g h² per step: 3e-8 over 3 s at
     h = 1e-4.  d = 1 − 1e-4 is MuJoCo's largest impedance (mjMAXIMP).  Measured with
-    `python -m engines.mujoco_restitution` (single vertex drop, γ = 0.3…0.95,
-    h = 1e-3…1e-5): see the table in that module's docstring.
+    `harness restitution --engine mujoco` (single vertex drop, γ = 0.3…0.95,
+    h = 1e-3…1e-5): see docs/engines.md, "The restitution contract".
 
     Integrator: Euler, MuJoCo's semi-implicit (symplectic) Euler, for which the one-step
     damper is exact and whose velocities we read at half steps (leapfrog; see

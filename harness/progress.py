@@ -56,3 +56,50 @@ def progress_bar(
     redirect = logging_redirect_tqdm(loggers=loggers) if shown else contextlib.nullcontext()
     with bar, redirect:
         yield bar
+
+
+class _Lines:
+    """A counter that prints one plain line to stderr at most every `every` seconds (and
+    at the end): progress of a long run in a log file without carriage returns."""
+
+    def __init__(self, total: int, desc: str, unit: str, every: float) -> None:
+        import time
+
+        self.total, self.desc, self.unit, self.every = total, desc, unit, every
+        self.n = 0
+        self._clock = time.perf_counter
+        self.start = self.last = self._clock()
+
+    def update(self, k: int = 1) -> None:
+        self.n += k
+        now = self._clock()
+        if now - self.last >= self.every:
+            self.last = now
+            self._line(now)
+
+    def _line(self, now: float) -> None:
+        print(
+            f"{self.desc}: {self.n}/{self.total} {self.unit}s, {now - self.start:.0f} s",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    def close(self) -> None:
+        if self.n:
+            self._line(self._clock())
+
+
+@contextlib.contextmanager
+def progress_counter(total: int, desc: str, unit: str = "run") -> Iterator:
+    """Progress of a long grid, always shown: a tqdm bar on a terminal, else a plain line
+    every REFRESH_FILE_S seconds and one at the end (no carriage returns in a log).
+    The object yielded has `update(k)`."""
+    if bars_wanted():
+        with progress_bar(total, desc, unit, show=True) as bar:
+            yield bar
+        return
+    lines = _Lines(total, desc, unit, REFRESH_FILE_S)
+    try:
+        yield lines
+    finally:
+        lines.close()

@@ -11,7 +11,8 @@ import pytest
 
 from engines import drake as dk
 from engines.base import contact_kinematics, effective_contact_mass
-from engines.drop import effective_restitution, single_vertex_drop
+from harness.restitution.drops import drop_scene, watched_point
+from harness.restitution.impact import read_impact
 from reference import quaternion as qt
 from reference.geometry import initial_state
 from tests.conftest import make_scene
@@ -94,13 +95,20 @@ def test_hunt_crossley_bounce_at_the_typical_speed_is_gamma(gamma):
     u = dk.hc_speed_factor(gamma)
     assert abs(dk.hc_restitution(u) - gamma) < 1e-12
     v = 1.0
-    scene = single_vertex_drop(gamma, v0=v, h0=0.002, t_end=0.02)
+    scene = drop_scene("vertex", gamma, v, 0.002 / v, 0.02)
     settings = dk.contact_settings(scene, 1e-4, "continuous")
     import dataclasses
 
     settings = dataclasses.replace(settings, hc_dissipation=u / v, accuracy=1e-7)
-    e = effective_restitution(scene, _states(dk.run_with_settings(scene, settings)))
+    e = _bounce(scene, dk.run_with_settings(scene, settings))
     assert abs(e - gamma) < 5e-3 * max(1.0, gamma / 0.3)
+
+
+def _bounce(scene, traj) -> float:
+    """e_eff of the drop's vertex 0 (the restitution study's reading)."""
+    reading = read_impact(scene, traj, *watched_point("vertex"))
+    assert reading.outcome == "ok"
+    return reading.e_eff
 
 
 def test_hunt_crossley_small_dissipation_gives_the_linear_limit():
@@ -114,8 +122,8 @@ def test_sap_single_vertex_bounce_is_gamma_within_three_percent(gamma):
     """The step map hits γ at the middle onset phase; other phases spread e by ±1.3 % at
     γ = 0.5 (N = 28 steps) and the gravity impulse over the contact, g N h, is 1 % of
     the approach speed 0.3."""
-    scene = single_vertex_drop(gamma, v0=0.3, h0=0.002, t_end=0.05)
-    e = effective_restitution(scene, _states(dk.simulate_drake(scene, 1e-4, profile="sap")))
+    scene = drop_scene("vertex", gamma, 0.3, 0.002 / 0.3, 0.05)
+    e = _bounce(scene, dk.simulate_drake(scene, 1e-4, profile="sap"))
     assert abs(e - gamma) < 0.03 * gamma
 
 

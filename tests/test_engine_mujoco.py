@@ -18,7 +18,6 @@ from engines.mujoco import (
     state_from_kinematics,
 )
 from engines.mujoco_model import load_model
-from engines.mujoco_restitution import effective_restitution, single_vertex_drop
 from reference.scene import scene_from_dict
 from tests.oracle.body import BodyModel, initial_state
 
@@ -139,14 +138,11 @@ def test_vectorised_contact_kinematics_match_the_body_model():
 # ------------------------------------------------------------------ restitution
 @pytest.mark.parametrize("gamma", [0.3, 0.5, 0.8, 0.95])
 def test_tuned_single_vertex_restitution_within_one_percent_at_dt_1e4(gamma):
-    scene = single_vertex_drop(gamma)  # only vertex 0 touches
-    traj = simulate_mujoco(scene, 1e-4, profile="tuned")
-    states = np.column_stack([traj.position, traj.quaternion, traj.velocity, traj.angular_velocity])
-    e = effective_restitution(scene, states)
-    assert e == pytest.approx(scene.restitution, rel=0.01)
-    first = traj.impacts[0]
-    assert first.contact == 0
-    assert -first.v_normal_post / first.v_normal_pre == pytest.approx(gamma, rel=0.01)
+    from harness.restitution.study import measure_cell
+
+    reading, _ = measure_cell("mujoco", "vertex", 1e-4, gamma, 1.0)  # only vertex 0 touches
+    assert reading.outcome == "ok"
+    assert reading.e_eff == pytest.approx(gamma, rel=0.01)
 
 
 # ------------------------------------------------------------------ impacts

@@ -16,7 +16,7 @@ def register(sub) -> None:
         "inputs",
         nargs="+",
         metavar="INPUT",
-        help="JSON of compare/bench/fidelity/stress/sweep, or a sweep directory",
+        help="JSON of compare/bench/fidelity/stress/sweep/restitution, or a sweep directory",
     )
     r.add_argument(
         "--out", required=True, metavar="FILE.html", help="the HTML file to write (.html)"

@@ -3,7 +3,8 @@
 Inputs (any number, in the order given):
 
 - a JSON document of `harness compare --json`, `bench --json` / `--out`, `fidelity
-  --json` / `--out`, `stress --json` or `sweep exponent --json`;
+  --json` / `--out`, `stress --json`, `sweep exponent --json` or `restitution --json` /
+  `--out`;
 - a sweep directory: ROOT/<engine> (holding manifest.json and parts/), or a study
   directory ROOT holding several of them (one section per engine).
 
@@ -28,6 +29,7 @@ from pathlib import Path
 from typing import Any
 
 from .html import details, esc, page
+from .restitution import restitution_section
 from .sections import (
     bench_section,
     compare_section,
@@ -38,7 +40,7 @@ from .sections import (
     sweep_section,
 )
 
-KINDS = ("compare", "bench", "fidelity", "stress", "sweep")
+KINDS = ("compare", "bench", "fidelity", "stress", "sweep", "restitution")
 
 
 class ReportInputError(ValueError):
@@ -93,7 +95,7 @@ def load_inputs(path: str | Path) -> list[ReportInput]:
     kind = detect_kind(doc)
     if kind is None:
         raise ReportInputError(
-            f"{p}: not a result of harness compare, bench, fidelity, stress or sweep"
+            f"{p}: not a result of harness compare, bench, fidelity, stress, sweep or restitution"
         )
     return [ReportInput(p, kind, doc)]
 
@@ -136,6 +138,8 @@ def section(item: ReportInput, out_dir: Path) -> str:
         body = fidelity_section(doc)
     elif item.kind == "stress":
         body = stress_section(doc)
+    elif item.kind == "restitution":
+        body = restitution_section(doc)
     else:
         body = sweep_section(doc)
     return (
