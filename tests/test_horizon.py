@@ -175,3 +175,45 @@ def test_displacement_and_difference_are_inverse():
     step = np.arange(1, 13) * 1e-6
     assert np.allclose(difference(scene, displaced(scene, y, step), y), step, atol=1e-12)
     assert units(scene).shape == (12,)
+
+
+def test_compare_json_has_the_horizon_object_of_each_run(capsys):
+    import json
+
+    from harness.cli import main
+
+    args = ["compare", "pentagon-bounce", "--engine", "mujoco", "--engine", "linear"]
+    assert main([*args, "--dt", "1e-3", "--horizon-runs", "4", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    mujoco, linear = doc["engines"]
+    h = mujoco["horizon"]
+    for key in ("matched_quantiles", "within", "own_error", "own_error_quantiles"):
+        assert key in h
+    assert h["lyapunov_per_impact"] > 0
+    q = h["matched_quantiles"]
+    assert q[0] <= q[1] <= q[2]
+    assert h["within"] == (mujoco["impacts_matched"] >= q[0])
+    assert h["own_error"] > 0 and len(h["own_error_quantiles"]) == 3
+    assert linear["horizon"]["matched_quantiles"] is None  # event-driven: level (b) only
+    assert linear["horizon"]["within"] is None
+    assert linear["horizon"]["own_error_quantiles"] is not None
+
+
+def test_compare_without_horizon_runs_has_no_verdict(capsys):
+    import json
+
+    from harness.cli import main
+
+    args = ["compare", "triangle-chatter", "--engine", "linear", "--horizon-runs", "0"]
+    assert main([*args, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["engines"][0]["horizon"] is None
+
+
+def test_fidelity_fails_a_run_only_below_the_horizon_band():
+    from harness.fidelity.study import horizon_verdict
+
+    band = [4.0, 6.0, 8.0]
+    assert horizon_verdict(5, band, False, None)["horizon_pass"]  # 5 of 10: within the band
+    assert not horizon_verdict(3, band, False, None)["horizon_pass"]  # below it
+    assert not horizon_verdict(9, band, True, False)["horizon_pass"]  # c failed
+    assert horizon_verdict(3, None, False, None)["horizon_pass"] is None

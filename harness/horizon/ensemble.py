@@ -128,13 +128,18 @@ def perturbed_ensemble(
 
 
 def grid_member(
-    scene: Scene, reference: Trajectory, dt: float, phase: float, tail: float
+    scene: Scene,
+    reference: Trajectory,
+    dt: float,
+    phase: float,
+    tail: float,
+    limit: int | None = None,
 ) -> Member:
     """One run of the grid model, stopped once it has diverged from the reference (the
-    match is checked every CHECK_EVERY impacts) or after as many impacts as the
-    reference has plus CHECK_EVERY."""
+    match is checked every CHECK_EVERY impacts) or after `limit` impacts (default: as
+    many as the reference has plus CHECK_EVERY)."""
     run = GridRun(scene, dt, phase, reference.t_final, tail)
-    limit = len(reference.impacts) + CHECK_EVERY
+    limit = len(reference.impacts) + CHECK_EVERY if limit is None else limit
     while run.step():
         if len(run.impacts) >= limit:
             break
@@ -153,13 +158,15 @@ def grid_ensemble(
     runs: int = DEFAULT_RUNS,
     seed: int = DEFAULT_SEED,
     progress: Callable[[], None] | None = None,
+    limit: int | None = None,
 ) -> list[Member]:
-    """`runs` grid-model runs at dt with phases uniform in [0, dt) (grid.py)."""
+    """`runs` grid-model runs at dt with phases uniform in [0, dt) (grid.py), each of
+    at most `limit` impacts (grid_member)."""
     tail = tail_speed(reference, scene.gravity, dt)
     members = []
     for i in range(runs):
         phase = float(member_rng(seed, i).uniform(0.0, dt))
-        members.append(grid_member(scene, reference, dt, phase, tail))
+        members.append(grid_member(scene, reference, dt, phase, tail, limit))
         if progress is not None:
             progress()
     return members
