@@ -177,14 +177,34 @@ def test_displacement_and_difference_are_inverse():
     assert units(scene).shape == (12,)
 
 
-def test_compare_json_has_the_horizon_object_of_each_run(capsys):
+def test_compare_json_has_the_horizon_object_of_each_run_and_the_recording_its_band(
+    capsys, tmp_path
+):
     import json
 
+    import rerun as rr
+
     from harness.cli import main
+    from harness.recording.horizon import band_times
+    from harness.scenes import resolve_scene
 
     args = ["compare", "pentagon-bounce", "--engine", "mujoco", "--engine", "linear"]
-    assert main([*args, "--dt", "1e-3", "--horizon-runs", "4", "--json"]) == 0
+    rrd = tmp_path / "h.rrd"
+    assert main([*args, "--dt", "1e-3", "--horizon-runs", "4", "--json", "--record", str(rrd)]) == 0
     doc = json.loads(capsys.readouterr().out)
+    store = rr.chunk.RrdReader(rrd).store()
+    chunks = store.stream().filter(content="/impacts/mujoco_dt1e-03/horizon_band").to_chunks()
+    times = np.concatenate(
+        [
+            c.to_record_batch().column("sim_time").cast("int64").to_numpy()
+            for c in chunks
+            if "sim_time" in c.to_record_batch().schema.names
+        ]
+    )
+    reference = simulate(resolve_scene("pentagon-bounce"))
+    quantiles = doc["engines"][0]["horizon"]["matched_quantiles"]
+    expected = band_times(reference.impact_times(), quantiles)
+    assert np.allclose(np.sort(times) * 1e-9, expected, atol=1e-8)
     mujoco, linear = doc["engines"]
     h = mujoco["horizon"]
     for key in ("matched_quantiles", "within", "own_error", "own_error_quantiles"):
