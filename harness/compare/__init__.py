@@ -80,7 +80,7 @@ class CompareResult:
 
     def to_dict(self) -> dict[str, Any]:
         """The contract's `compare` document, plus the exponents and the verdicts."""
-        from .text import divergence_sentence, verdict_line
+        from .text import divergence_sentence, horizon_sentence, verdict_line
 
         ref = self.reference.summary(with_impacts=False)
         ref["wall_time_s"] = self.reference_wall_time_s
@@ -93,6 +93,8 @@ class CompareResult:
         for run in self.runs:
             row = run.to_dict()
             row["verdict"] = verdict_line(run, self.scene)
+            if row["horizon"] is not None:
+                row["horizon"]["sentence"] = horizon_sentence(run)
             engines.append(row)
         return {
             "scene": self.scene.name,
