@@ -237,3 +237,21 @@ def test_fidelity_fails_a_run_only_below_the_horizon_band():
     assert not horizon_verdict(3, band, False, None)["horizon_pass"]  # below it
     assert not horizon_verdict(9, band, True, False)["horizon_pass"]  # c failed
     assert horizon_verdict(3, None, False, None)["horizon_pass"] is None
+
+
+def test_compare_text_stays_within_100_columns_with_the_band_and_long_names():
+    from harness.compare import compare, format_compare
+    from harness.horizon.verdict import Horizon
+    from harness.scenes import resolve_scene
+
+    result = compare(resolve_scene("pentagon-bounce"), ["linear"])
+    run = result.runs[0]
+    run.engine, run.dt = "pybullet-default", 1e-4  # the longest built-in label
+    run.horizon = Horizon(
+        22, [15.0, 18.0, 22.0], 1e-4, 0, [12.0, 20.0, 30.0], 25.0, 0.12, 24, 0, 1e-4
+    )
+    text = format_compare(result)
+    assert max(len(line) for line in text.splitlines()) <= 100
+    assert "matches 15–22 (10–90 %, 24 grid phases), within it" in text
+    run.engine = "mujoco"
+    assert "15–22 in" in format_compare(result)
