@@ -19,13 +19,14 @@ is built on the public reference, impact by impact:
    so the impact law, the paper's rule beside held contacts and the chatter completion
    are the reference's own, applied at the grid time.
 
-Slow impacts, those `compare` skips as chatter tails (approach slower than
-`harness.metrics.slow_impact_speed`, 10 g dt or 1 % of the fastest), are applied
-exactly, undelayed: an engine merges such bounces into sustained contact, and delaying
-every bounce of a chatter sequence by up to a step would make it last for ever (the
-bounce speed tends to g·dt/(1 − γ) instead of zero).  Contact phases (held contacts,
-γ = 0 or after a chatter completion) are the reference's, undelayed: they are not
-impacts.
+Chatter-tail impacts, those `compare` may skip (`harness.metrics.chatter_tail`: slower
+than `slow_impact_speed`, 10 g dt or 1 % of the fastest, at a contact already in the
+current chatter episode), are applied exactly, undelayed: an engine merges such bounces
+into sustained contact, and delaying every bounce of a chatter sequence by up to a step
+would make it last for ever (the bounce speed tends to g·dt/(1 − γ) instead of zero).
+A slow impact at a contact new to the episode is delayed like any other.  Contact
+phases (held contacts, γ = 0 or after a chatter completion) are the reference's,
+undelayed: they are not impacts.
 
 What this model is not: an engine also integrates flights with O(dt) errors and
 resolves impacts over steps; the grid model keeps only the timing error that no
@@ -43,12 +44,13 @@ from reference import Status, Trajectory
 from reference.scene import Scene
 from reference.trajectory import ImpactEvent
 
+from ..metrics import chatter_tail
 from .state import flown, lifted, pre_impact_state, run_from, start_state
 
 GRID_MODEL = (
     "exact model, each impact applied at the next boundary of a step grid of width dt "
     "(random phase) after closed-form flight into the ground, the depth removed by "
-    "lifting along the normal; chatter-tail impacts exact"
+    "lifting along the normal; chatter-tail impacts (compare's rule) exact"
 )
 
 
@@ -88,7 +90,7 @@ class GridRun:
             self.status, self.message = sub.status, sub.message
             return False
         last = imps[-1]
-        if abs(last.v_normal_pre) < self.slow or self.dt == 0.0:  # exact
+        if self.dt == 0.0 or self._is_tail(last):  # exact
             self._keep(sub, len(imps))
             self.y, self.t, self.delayed = _last_state(sub), self.t + last.t, False
             return True
@@ -104,6 +106,18 @@ class GridRun:
         self.max_depth = max(self.max_depth, depth)
         self.t, self.delayed = t_grid, True
         return True
+
+    def _is_tail(self, event: ImpactEvent) -> bool:
+        """Whether `event`, after the impacts so far, is a chatter tail (compare's rule,
+        harness.metrics.chatter_tail, at this run's tail speed)."""
+        if abs(event.v_normal_pre) >= self.slow:
+            return False
+        events = [*self.impacts, event]
+        empty = np.zeros(0)
+        traj = Trajectory.from_states(
+            "grid", self.scene.name, empty, np.zeros((0, 13)), empty, empty, events, Status.T_END
+        )
+        return bool(chatter_tail(traj, self.slow)[-1])
 
     def _keep(self, sub: Trajectory, n_impacts: int, until: float | None = None) -> None:
         """Append the sub-run's first n_impacts impacts and its samples (those before
