@@ -10,7 +10,11 @@ ensemble's λ the median over members with at least MIN_POINTS such impacts.
 
 Horizon at another level: a member matched n impacts at level ε0 diverges where its
 separation reaches the matching window; at level ε it gets there ln(ε0/ε)/λ impacts
-later: n(ε) = n(ε0) + ln(ε0/ε)/λ (`predicted_horizon`).
+later: n(ε) = n(ε0) + ln(ε0/ε)/λ (`predicted_horizon`).  The growth is far from uniform
+along a motion (pentagon-bounce: slow over the first ~20 impacts, fast later), so over
+decades a constant λ extrapolates poorly; `profile_horizon` uses each member's own
+impact-time offsets instead, scaled by ε/ε0 (linear in the perturbation in the tangent
+regime), against the matching windows.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ import numpy as np
 from reference import Trajectory
 from reference.scene import Scene
 
+from ..metrics import impact_windows, match_tolerance
 from .ensemble import Member
 from .state import post_impact_states, separation
 
@@ -64,3 +69,24 @@ def predicted_horizon(n0: float, level0: float, level: float, rate: float | None
     if rate is None or rate <= 0 or level <= 0 or not math.isfinite(level):
         return None
     return max(0.0, n0 + math.log(level0 / level) / rate)
+
+
+def profile_horizon(
+    reference: Trajectory, members: list[Member], gravity: float, level0: float, level: float
+) -> float | None:
+    """Median over members of the first matched impact i where the member's impact-time
+    offset scaled to the new level, |t_run − t_ref|·ε/ε0, exceeds the matching window
+    w_i (harness.metrics.impact_windows with the member's tolerance: the run's dt); a
+    member whose scaled offsets stay inside counts its matched impacts.  In the tangent
+    regime offsets are linear in the perturbation, so this is where the member would
+    stop matching at level ε by the time criterion (a contact swap can come earlier).
+    None without members."""
+    ends = []
+    for m in members:
+        if m.match.n_matched == 0:
+            continue
+        tol = match_tolerance(m.trajectory, reference, gravity)
+        w = impact_windows(reference, tol)[m.match.pairs[:, 0]]
+        over = np.flatnonzero(np.abs(m.match.time_errors) * (level / level0) > w)
+        ends.append(float(m.match.pairs[over[0], 0]) if len(over) else float(m.matched))
+    return float(np.median(ends)) if ends else None

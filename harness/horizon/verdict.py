@@ -11,8 +11,9 @@ as the separation (state.separation) of its state from the reference's in the fl
 after its first matched impact (`own_error`), then the reference perturbed at that
 level from just after that impact (ensemble.perturbed_ensemble): `own_error_quantiles`
 are the matched counts this error alone allows; `own_error_predicted` the count the
-growth per impact predicts from the scene's ensemble at LYAPUNOV_LEVEL
-(lyapunov.predicted_horizon, a constant rate extrapolated over decades: coarse).  A
+growth of the scene's ensemble at LYAPUNOV_LEVEL predicts for that level
+(lyapunov.profile_horizon: each member's impact-time offsets scaled to it, against the
+windows; it treats the error as if made at the start).  A
 run matching far less than (b) diverges for another reason than its error at the first
 impact; a run whose (b) is far below (a) makes a larger error than its timestep forces.
 
@@ -40,7 +41,7 @@ from .ensemble import (
     rematched,
 )
 from .grid import GRID_MODEL
-from .lyapunov import LYAPUNOV_LEVEL, lyapunov_per_impact, predicted_horizon
+from .lyapunov import LYAPUNOV_LEVEL, lyapunov_per_impact, profile_horizon
 from .settings import DEFAULT_RUNS, DEFAULT_SEED
 from .state import flown, post_impact_states, separation
 
@@ -163,12 +164,12 @@ def engine_horizon(
         grid = grid_ensemble(scene, reference, dt, shared.runs, shared.seed, progress)
         band = quantiles(matched_counts(grid))
     err, at = own_error(scene, reference, run, match)
-    own_q = predicted = None  # predicted: lyapunov.predicted_horizon
+    own_q = predicted = None
     if err is not None and err > 0:
         own = perturbed_ensemble(scene, reference, err, shared.runs, shared.seed, at, dt, progress)
         own_q = quantiles(matched_counts(own))
-        base = matched_counts(rematched(shared.members, reference, g, dt))
-        predicted = predicted_horizon(float(np.median(base)), LYAPUNOV_LEVEL, err, shared.lyapunov)
+        base = rematched(shared.members, reference, g, dt)
+        predicted = profile_horizon(reference, base, g, LYAPUNOV_LEVEL, err)
     return Horizon(
         match.n_matched, band, err, at, own_q, predicted, shared.lyapunov, shared.runs,
         shared.seed, dt,
