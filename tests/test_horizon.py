@@ -255,3 +255,13 @@ def test_compare_text_stays_within_100_columns_with_the_band_and_long_names():
     assert "matches 15–22 (10–90 %, 24 grid phases), within it" in text
     run.engine = "mujoco"
     assert "15–22 in" in format_compare(result)
+
+
+def test_profile_prediction_from_the_deep_ensemble_matches_the_shallow_one(elastic):
+    from harness.horizon.lyapunov import profile_horizon
+
+    reference, shallow, deep, _ = elastic
+    predicted = profile_horizon(reference, deep, ELASTIC_TRIANGLE.gravity, 1e-7, 1e-4)
+    measured = float(np.median(matched_counts(shallow)))
+    print(f"profile prediction {predicted}, ensemble {measured}")
+    assert predicted == pytest.approx(measured, rel=0.25)
