@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -77,6 +77,8 @@ def scene_horizon(
     seed: int = DEFAULT_SEED,
     progress: Callable[[], None] | None = None,
 ) -> SceneHorizon:
+    """The shared part (SceneHorizon): `runs` members from the initial state perturbed
+    at LYAPUNOV_LEVEL (event-driven windows; `rematched` judges them at a run's dt)."""
     members = perturbed_ensemble(scene, reference, LYAPUNOV_LEVEL, runs, seed, None, None, progress)
     return SceneHorizon(members, lyapunov_per_impact(scene, reference, members), runs, seed)
 
@@ -95,7 +97,6 @@ class Horizon:
     runs: int
     seed: int
     dt: float | None
-    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def within(self) -> bool | None:
