@@ -252,6 +252,7 @@ def test_compare_text_stays_within_100_columns_with_the_band_and_long_names():
     )
     text = format_compare(result)
     assert max(len(line) for line in text.splitlines()) <= 100
+    assert "15–22 in" in text  # the band kept, the cost left out
     assert "matches 15–22 (10–90 %, 24 grid phases), within it" in text
     run.engine = "mujoco"
     assert "15–22 in" in format_compare(result)

@@ -215,8 +215,9 @@ def _header(result: CompareResult) -> list[str]:
 
 
 def _verdict_table(result: CompareResult) -> str:
-    """One row per run; the `band` column only while the table fits WIDTH (with long
-    engine names it does not: the Horizon lines under the table give the band then)."""
+    """One row per run.  With long engine names beside an exponent the full table is wider
+    than WIDTH: then the `cost` column is left out (`--wide` has it), and if that is not
+    enough the `band` column too (the Horizon lines give the bands)."""
     rows = []
     for run in result.runs:
         m = run.metrics
@@ -234,12 +235,20 @@ def _verdict_table(result: CompareResult) -> str:
             ]
         )
     header = ["simulator", "impacts", "diverges", "why", "E err", "c", "cost", "band"]
-    text = table(rows, header, align="lrrlrrrl")
-    if max(len(line) for line in text.splitlines()) <= WIDTH:
-        return text
-    return table([r[:-1] for r in rows], header[:-1], align="lrrlrrr") + (
-        "\n(band column left out to stay within 100 characters: the Horizon lines give it)"
+    attempts = (
+        (range(8), ""),
+        ((0, 1, 2, 3, 4, 5, 7), "cost left out to stay within 100 characters: --wide has it"),
+        (range(7), "band left out to stay within 100 characters: the Horizon lines give it"),
     )
+    for keep, note in attempts:
+        text = table(
+            [[r[i] for i in keep] for r in rows],
+            [header[i] for i in keep],
+            align="".join("lrrlrrrl"[i] for i in keep),
+        )
+        if max(len(line) for line in text.splitlines()) <= WIDTH:
+            return text + (f"\n({note})" if note else "")
+    return text + f"\n({note})"
 
 
 def _first_to_diverge(result: CompareResult) -> list[str]:
