@@ -232,6 +232,30 @@ def add_max_steps(p: argparse.ArgumentParser) -> None:
 # ----------------------------------------------------------------------------- output
 
 
+def add_horizon(p: argparse.ArgumentParser) -> None:
+    """--horizon-runs, --horizon-seed: the ensembles of the horizon verdict
+    (harness.horizon; docs/fidelity.md, "Horizon")."""
+    from ..horizon.settings import DEFAULT_RUNS, DEFAULT_SEED
+
+    p.add_argument(
+        "--horizon-runs",
+        type=int_in(0, 10_000),
+        default=DEFAULT_RUNS,
+        metavar="N",
+        help="members of each horizon ensemble (reference runs: grid model at the run's dt, "
+        "perturbed at its own error, perturbed at 1e-8 for the growth per impact); 0: no "
+        "horizon verdict (default 24)",
+    )
+    p.add_argument(
+        "--horizon-seed",
+        type=int_in(0, 2**63 - 1),
+        default=DEFAULT_SEED,
+        metavar="SEED",
+        help="seed of the horizon ensembles (a member depends only on it and its number; "
+        "default 0)",
+    )
+
+
 def emit(doc: Any, as_json: bool, text: str) -> None:
     """Exactly one JSON document on stdout with --json, else the text."""
     if as_json:

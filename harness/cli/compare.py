@@ -6,6 +6,7 @@ from .common import (
     add_dt,
     add_engine,
     add_force,
+    add_horizon,
     add_json,
     add_max_steps,
     add_scale,
@@ -48,6 +49,7 @@ def register(sub) -> None:
         metavar="FILE",
         help="write the impact-by-impact diff to FILE (.csv or .parquet; docs/output.md)",
     )
+    add_horizon(c)
     add_force(c)
     add_json(c)
     c.set_defaults(func=run)
@@ -77,7 +79,14 @@ def run(args) -> int:
         check_distinct([recording_path(args.record), args.out])
     recording = None
     result = compare(
-        scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log, max_steps=args.max_steps
+        scene,
+        args.engine,
+        dts=args.dt,
+        t_end=args.t_end,
+        progress=log,
+        max_steps=args.max_steps,
+        horizon_runs=args.horizon_runs,
+        horizon_seed=args.horizon_seed,
     )
     if args.record:
         from ..recording import record_comparison

@@ -6,6 +6,7 @@ from .common import (
     add_dt,
     add_engine,
     add_force,
+    add_horizon,
     add_json,
     budget,
     emit,
@@ -70,6 +71,7 @@ def register(sub) -> None:
     )
     f.add_argument("--plot", metavar="FILE.png", help="alpha* against dt with the fitted k")
     f.add_argument("--out", metavar="FILE.json", help="also write the JSON document here")
+    add_horizon(f)
     add_force(f)
     add_json(f)
     f.set_defaults(func=run)
@@ -96,6 +98,8 @@ def run(args) -> int:
         window=args.window,
         budget_s=args.budget,
         progress=log,
+        horizon_runs=args.horizon_runs,
+        horizon_seed=args.horizon_seed,
     )
     attach(doc, args)
     write_outputs(args, doc)

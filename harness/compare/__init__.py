@@ -24,6 +24,8 @@ from reference.exponent import ExponentFit
 from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
+from ..horizon.settings import DEFAULT_SEED
+from ..horizon.verdict import Horizon, engine_horizon, planned_members, scene_horizon
 from ..metrics import RunMetrics, effective_restitution, evaluate, run_exponent
 from ..progress import progress_bar
 from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator, warm_up
@@ -39,6 +41,7 @@ class EngineRun:
     wall_time_s: float
     metrics: RunMetrics
     exponent: ExponentFit
+    horizon: Horizon | None = None
 
     @property
     def label(self) -> str:
@@ -57,6 +60,7 @@ class EngineRun:
         }
         doc.update(self.metrics.to_dict())
         doc["exponent"] = self.exponent.to_dict()
+        doc["horizon"] = None if self.horizon is None else self.horizon.to_dict()
         return doc
 
 
@@ -76,7 +80,7 @@ class CompareResult:
 
     def to_dict(self) -> dict[str, Any]:
         """The contract's `compare` document, plus the exponents and the verdicts."""
-        from .text import divergence_sentence, verdict_line
+        from .text import divergence_sentence, horizon_sentence, verdict_line
 
         ref = self.reference.summary(with_impacts=False)
         ref["wall_time_s"] = self.reference_wall_time_s
@@ -89,6 +93,8 @@ class CompareResult:
         for run in self.runs:
             row = run.to_dict()
             row["verdict"] = verdict_line(run, self.scene)
+            if row["horizon"] is not None:
+                row["horizon"]["sentence"] = horizon_sentence(run)
             engines.append(row)
         return {
             "scene": self.scene.name,
@@ -113,12 +119,17 @@ def compare(
     t_end: float | None = None,
     progress: Callable[[str], None] | None = None,
     max_steps: int | None = None,
+    horizon_runs: int = 0,
+    horizon_seed: int = DEFAULT_SEED,
 ) -> CompareResult:
     """Run the reference once and each engine at each dt (DEFAULT_DT when `dts` is None;
     once for `reference` and `linear`), all to the same t_end, and score every run.
     Each simulator is warmed up before it is timed.  `progress` gets one line per run
     with its wall time (for stderr).  An engine run stopped by Ctrl-C stops the
-    comparison (KeyboardInterrupt)."""
+    comparison (KeyboardInterrupt).  Then each run but the reference's gets its horizon
+    (harness.horizon.verdict) from ensembles of `horizon_runs` members seeded with
+    `horizon_seed` (0, the default here: no horizons; the CLI's default is
+    harness.horizon.settings.DEFAULT_RUNS)."""
     say = progress or (lambda _msg: None)
     dts = list(dts) if dts else [DEFAULT_DT]
     plan = [(e, dt) for e in engines for dt in (dts if is_fixed_step(e) else [None])]
@@ -139,7 +150,36 @@ def compare(
             fit = run_exponent(traj, scene, reference, metrics.match)
             runs.append(EngineRun(engine, dt, traj, wall, metrics, fit))
             bar.update()
+    if horizon_runs > 0:
+        add_horizons(scene, reference, runs, horizon_runs, horizon_seed, say)
     return CompareResult(scene, reference, ref_wall, runs, run_exponent(reference, scene))
+
+
+def add_horizons(
+    scene: Scene,
+    reference: Trajectory,
+    runs: list[EngineRun],
+    members: int,
+    seed: int,
+    say: Callable[[str], None],
+) -> None:
+    """Each run's horizon verdict (harness.horizon.verdict), with a progress bar over
+    the ensembles' members."""
+    judged = [r for r in runs if r.engine != "reference"]
+    if not judged:
+        return
+    start = time.perf_counter()
+    total = planned_members(members, [r.dt is not None for r in judged])
+    with progress_bar(total, f"horizon {scene.name}", unit="member") as bar:
+        shared = scene_horizon(scene, reference, members, seed, bar.update)
+        for r in judged:
+            bar.set_postfix_str(r.label, refresh=False)
+            match = r.metrics.match
+            if match is None:
+                continue
+            r.horizon = engine_horizon(scene, reference, r.trajectory, match, shared, bar.update)
+    say(f"compare: horizons of {len(judged)} run(s), {members} members each ("
+        f"{time.perf_counter() - start:.2f} s)")  # fmt: skip
 
 
 def _timed_run(

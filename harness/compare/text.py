@@ -64,6 +64,62 @@ def _exponent_cell(fit) -> str:
     return f"{fit.c:.2f}±{fit.c_stderr:.1g}"
 
 
+def _count_range(q: list[float]) -> str:
+    """'15–22' from [10 %, 50 %, 90 %] quantiles of matched counts ('15' when equal)."""
+    lo, hi = f"{q[0]:.0f}", f"{q[2]:.0f}"
+    return lo if lo == hi else f"{lo}–{hi}"
+
+
+def horizon_cell(run: EngineRun) -> str:
+    """The table's `band`: level (a)'s 10–90 % range and whether the run's count is
+    within it ('15–22 in', '15–22 low'); event-driven runs: level (b)'s range after 'b '."""
+    h = run.horizon
+    if h is None:
+        return "-"
+    if h.matched_quantiles is not None:
+        return f"{_count_range(h.matched_quantiles)} {'in' if h.within else 'low'}"
+    if h.own_error_quantiles is not None:
+        return f"b {_count_range(h.own_error_quantiles)}"
+    return "-"
+
+
+def _horizon_wide(run: EngineRun) -> list[str]:
+    """band(a) with the verdict, own error, band(b): the wide table's horizon cells."""
+    h = run.horizon
+    if h is None:
+        return ["-", "-", "-"]
+    a = "-" if h.matched_quantiles is None else horizon_cell(run)
+    b = "-" if h.own_error_quantiles is None else _count_range(h.own_error_quantiles)
+    return [a, _num(h.own_error), b]
+
+
+def horizon_sentence(run: EngineRun) -> str | None:
+    """The run's horizon verdict as a sentence with the numbers (None without one)."""
+    h = run.horizon
+    if h is None:
+        return None
+    m = run.metrics
+    parts = [f"{run.label} matches {m.impacts_matched}"]
+    if h.matched_quantiles is not None:
+        verdict = (
+            "within it: the divergence is the scene's chaos at this timestep"
+            if h.within
+            else "below it: look at the contact model"
+        )
+        parts.append(
+            f"the exact model with its impacts on a {run.dt:g} s step grid matches "
+            f"{_count_range(h.matched_quantiles)} (10–90 %, {h.runs} grid phases), {verdict}"
+        )
+    if h.own_error_quantiles is not None:
+        parts.append(
+            f"its own error after impact {h.own_error_impact} ({h.own_error:.1e}) lets the "
+            f"perturbed exact model match {_count_range(h.own_error_quantiles)}"
+        )
+    elif h.own_error is None:
+        parts.append("its own error could not be measured (no matched impact with a flight after)")
+    return "; ".join(parts) + "."
+
+
 # ----------------------------------------------------------------------------- why
 
 
@@ -159,6 +215,9 @@ def _header(result: CompareResult) -> list[str]:
 
 
 def _verdict_table(result: CompareResult) -> str:
+    """One row per run.  With long engine names beside an exponent the full table is wider
+    than WIDTH: then the `cost` column is left out (`--wide` has it), and if that is not
+    enough the `band` column too (the Horizon lines give the bands)."""
     rows = []
     for run in result.runs:
         m = run.metrics
@@ -172,10 +231,24 @@ def _verdict_table(result: CompareResult) -> str:
                 _num(m.energy_error_agreeing),
                 _exponent_cell(run.exponent),
                 seconds(run.wall_time_s),
+                horizon_cell(run),
             ]
         )
-    header = ["simulator", "impacts", "diverges", "why", "E err", "c", "cost"]
-    return table(rows, header, align="lrrlrrr")
+    header = ["simulator", "impacts", "diverges", "why", "E err", "c", "cost", "band"]
+    attempts = (
+        (range(8), ""),
+        ((0, 1, 2, 3, 4, 5, 7), "cost left out to stay within 100 characters: --wide has it"),
+        (range(7), "band left out to stay within 100 characters: the Horizon lines give it"),
+    )
+    for keep, note in attempts:
+        text = table(
+            [[r[i] for i in keep] for r in rows],
+            [header[i] for i in keep],
+            align="".join("lrrlrrrl"[i] for i in keep),
+        )
+        if max(len(line) for line in text.splitlines()) <= WIDTH:
+            return text + (f"\n({note})" if note else "")
+    return text + f"\n({note})"
 
 
 def _first_to_diverge(result: CompareResult) -> list[str]:
@@ -187,7 +260,22 @@ def _first_to_diverge(result: CompareResult) -> list[str]:
         f"First to diverge: {first.label} at t = {t:.6g} s: "
         f"{divergence_sentence(first, result.scene)}."
     )
-    return textwrap.wrap(text, WIDTH, subsequent_indent="  ")
+    return textwrap.wrap(text, WIDTH, subsequent_indent="  ") + _horizon_lines(result)
+
+
+def _horizon_lines(result: CompareResult) -> list[str]:
+    """One sentence per run with a horizon, and the scene's growth per impact."""
+    sentences = [s for s in (horizon_sentence(r) for r in result.runs) if s]
+    if not sentences:
+        return []
+    rate = next(r.horizon.lyapunov_per_impact for r in result.runs if r.horizon is not None)
+    head = "Horizon: a separation grows by e^λ per impact, λ = " + (
+        "-" if rate is None else f"{rate:.3g}"
+    )
+    lines = textwrap.wrap(head + " (perturbed exact model, docs/fidelity.md).", WIDTH)
+    for text in sentences:
+        lines += textwrap.wrap(text, WIDTH, initial_indent="  ", subsequent_indent="    ")
+    return lines
 
 
 LEGEND = (
@@ -197,7 +285,10 @@ LEGEND = (
     "that disagrees, or attitude off by a tenth of the largest tilt. E err: "
     "max|E−E_ref|/E_ref(0) while the run follows the reference. c: energy exponent ± its "
     "standard error, "
-    "only for runs that reach the singularity. cost: wall time. v2 = vertex 2, b2 = bump 2. "
+    "only for runs that reach the singularity. cost: wall time. band: impacts the exact model "
+    "matches with its impacts on the run's step grid (10–90 %); in: the run's count is at "
+    "least the 10 % value; b: event-driven runs, the exact model perturbed at the run's own "
+    "error. v2 = vertex 2, b2 = bump 2. "
     "Every column: --wide; definitions: docs/output.md."
 )
 
@@ -244,6 +335,9 @@ def format_compare_wide(result: CompareResult) -> str:
         "e_eff",
         "c",
         "t_f from",
+        "band(a)",
+        "own_err",
+        "band(b)",
     ]
     rows = []
     for run in result.runs:
@@ -269,9 +363,10 @@ def format_compare_wide(result: CompareResult) -> str:
                 "-" if r.median is None else f"{r.median:.4f} (n={r.n})",
                 _exponent_cell(fit),
                 fit.t_f_source or "-",
+                *_horizon_wide(run),
             ]
         )
-    lines = [*_header(result), "", table(rows, header, align="lrlrrrrrrrrrrlrrl"), ""]
+    lines = [*_header(result), "", table(rows, header, align="lrlrrrrrrrrrrlrrllrl"), ""]
     lines += [
         "matched: leading impacts with the reference's contact and time, |dt| <= "
         f"{STEPS_TIME_TOLERANCE:g} steps (1e-9 s event-driven) + {RELATIVE_TIME_TOLERANCE:g}*t, "
@@ -286,6 +381,9 @@ def format_compare_wide(result: CompareResult) -> str:
         "max(10 g dt, 1% of the fastest)",
         "c: energy exponent of E ~ a (t_f - t)^c ± standard error (reference.exponent), only "
         "for runs that reach the singularity; t_f from: where t_f came from",
+        "band(a): 10-90 % of the impacts matched by the exact model with impacts on the run's "
+        "step grid (in: count >= 10 %); own_err: the run's state error after its first matched "
+        "impact; band(b): 10-90 % matched by the exact model perturbed at that error",
     ]
     for run in result.runs:
         m = run.metrics

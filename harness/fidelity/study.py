@@ -142,8 +142,16 @@ def scale_case(scene: Scene, eps: float, criteria: FidelityCriteria) -> ScaleCas
 # ----------------------------------------------------------------------------- one run
 
 
-def score(traj: Trajectory, case: ScaleCase, criteria: FidelityCriteria) -> dict[str, Any]:
-    """The metrics of one engine run at one scale and its verdict."""
+def score(
+    traj: Trajectory,
+    case: ScaleCase,
+    criteria: FidelityCriteria,
+    band: list[float] | None = None,
+) -> dict[str, Any]:
+    """The metrics of one engine run at one scale and its verdicts: `passes` (the
+    criteria) and `horizon_pass` (it passes, or its leading impacts matched are at least
+    the 10 % quantile of the horizon band at this scale and dt, `band`: it fails only
+    below the band)."""
     m = evaluate(traj, case.reference, case.scene.gravity)
     pairs = m.match.pairs if m.match is not None else np.zeros((0, 2), int)
     in_leading = np.isin(pairs[:, 0], case.leading.indices)
@@ -181,7 +189,39 @@ def score(traj: Trajectory, case: ScaleCase, criteria: FidelityCriteria) -> dict
         "criterion": "impacts and c" if c_ok is not None else "impacts only",
         "impacts_pass": impacts_ok,
         "passes": bool(impacts_ok and c_ok is not False),
+        **horizon_verdict(matched, band, impacts_ok, c_ok),
     }
+
+
+def horizon_verdict(
+    matched: int, band: list[float] | None, impacts_ok: bool, c_ok: bool | None
+) -> dict[str, Any]:
+    """`horizon_band` (leading impacts the grid model matches, 10/50/90 %), `within_horizon`
+    (matched ≥ its 10 % value) and `horizon_pass` (impacts pass or within, and c not
+    failed); None without a band (event-driven runs, --horizon-runs 0)."""
+    if band is None:
+        return {"horizon_band": None, "within_horizon": None, "horizon_pass": None}
+    within = matched >= band[0]
+    return {
+        "horizon_band": band,
+        "within_horizon": within,
+        "horizon_pass": bool((impacts_ok or within) and c_ok is not False),
+    }
+
+
+def horizon_band(case: ScaleCase, dt: float | None, runs: int, seed: int) -> list[float] | None:
+    """The grid model's leading impacts matched at this scale and dt (harness.horizon:
+    `runs` grid phases, each run stopped after the last leading impact), as 10/50/90 %
+    quantiles; None for event-driven runs, no runs or no leading impacts."""
+    if dt is None or runs <= 0 or case.leading.n == 0:
+        return None
+    from ..horizon.ensemble import grid_ensemble
+    from ..horizon.verdict import quantiles
+
+    limit = int(case.leading.indices[-1]) + 2
+    members = grid_ensemble(case.scene, case.reference, dt, runs, seed, limit=limit)
+    counts = [int(np.isin(m.match.pairs[:, 0], case.leading.indices).sum()) for m in members]
+    return quantiles(np.array(counts))
 
 
 def _base_row(engine: str, dt: float | None, case: ScaleCase, t_run: float) -> dict[str, Any]:
@@ -211,11 +251,12 @@ def engine_row(
     budget_s: float,
     measured: Sequence[tuple[float, float]] = (),
     blocked: str | None = None,
+    band: list[float] | None = None,
 ) -> dict[str, Any]:
     """Run one engine at one scale within the budget (module docstring) and score it.
     `measured`: (steps, wall time) of this engine and dt at the smaller scales already
     run; `blocked`: the reason a smaller scale of this engine and dt was not run (this
-    one, costlier, is skipped with it)."""
+    one, costlier, is skipped with it); `band`: the horizon band there (`score`)."""
     t_run = run_end(case.leading, case.reference.t_final, case.scene.run.t_end, dt, window)
     row = _base_row(engine, dt, case, t_run)
     if case.leading.n == 0:
@@ -227,7 +268,8 @@ def engine_row(
     scene = case.scene.with_run(t_end=t_run)
     if dt is not None and dt > t_run:  # not one step fits: it cannot follow any impact
         why = f"dt = {dt:g} s is longer than the whole run at this scale ({t_run:.3g} s)"
-        return {**row, **score(Trajectory.failed(engine, scene.name, dt, why), case, criteria)}
+        failed = Trajectory.failed(engine, scene.name, dt, why)
+        return {**row, **score(failed, case, criteria, band)}
     predicted = predict_run_time(engine, scene, dt, row["steps"], measured)
     row["predicted_wall_time_s"] = predicted
     if predicted is not None and predicted > budget_s:
@@ -238,7 +280,7 @@ def engine_row(
         traj, wall, err = timed(lambda: run_simulator(engine, scene, dt, t_run))
         if traj is None:
             traj = Trajectory.failed(engine, scene.name, dt, err or "")
-        return {**score(traj, case, criteria), "wall_time_s": wall}
+        return {**score(traj, case, criteria, band), "wall_time_s": wall}
 
     if row["steps"] is None or row["steps"] <= PILOT_FREE_STEPS:  # short: run here
         return {**row, **scored_run()}
@@ -249,7 +291,7 @@ def engine_row(
         return row
     if result is None:  # the child died without answering (a crash inside the engine)
         failed = Trajectory.failed(engine, scene.name, dt, crashed or "")
-        result = {**score(failed, case, criteria), "wall_time_s": None}
+        result = {**score(failed, case, criteria, band), "wall_time_s": None}
     return {**row, **result}
 
 
@@ -294,10 +336,15 @@ def fidelity(
     window: str = "leading",
     budget_s: float = DEFAULT_BUDGET_S,
     progress: Callable[[str], None] | None = None,
+    horizon_runs: int = 0,
+    horizon_seed: int = 0,
 ) -> dict[str, Any]:
     """The fidelity study of `scene` (module docstring; definitions in harness.fidelity).
     Returns the JSON document: criteria, the reference at every scale, one row per
-    engine, dt and scale, α* per engine and dt, the power-law fit per engine."""
+    engine, dt and scale, α* per engine and dt, the power-law fit per engine.  With
+    `horizon_runs` > 0 each fixed-step row also gets the horizon band of its scale and
+    dt (`horizon_band`, grid phases seeded with `horizon_seed`) and each α* entry a
+    `horizon` α*: the engine fails at a scale only below that band."""
     say = progress or (lambda _msg: None)
     criteria = criteria or FidelityCriteria()
     if criteria.leading < 1:
@@ -318,9 +365,14 @@ def fidelity(
             cases.append(scale_case(scene, e, criteria))
             bar.update()
         say(_reference_line(scene, cases))
+        bands: dict[tuple[float, float | None], list[float] | None] = {}
         for engine, dt in plan:
             warm_up(engine, cases[0].scene, dt)
-            rows += _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say)
+            for c in cases:
+                if (c.eps, dt) not in bands:
+                    bands[c.eps, dt] = horizon_band(c, dt, horizon_runs, horizon_seed)
+            mine = {c.eps: bands[c.eps, dt] for c in cases}
+            rows += _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say, mine)
     stars = _alpha_stars(rows, plan)
     return {
         "kind": "fidelity",
@@ -334,6 +386,8 @@ def fidelity(
         "eps": eps,
         "budget_s": budget_s,
         "hard_cap_s": HARD_CAP_FACTOR * budget_s,
+        "horizon_runs": horizon_runs,
+        "horizon_seed": horizon_seed,
         "reference": [c.to_dict(cases[0]) for c in cases],
         "runs": rows,
         "alpha_star": stars,
@@ -344,13 +398,15 @@ def fidelity(
     }
 
 
-def _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say) -> list[dict]:
-    """One engine at one dt over every scale, smallest ε first (budget: module docstring)."""
+def _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say, bands) -> list[dict]:
+    """One engine at one dt over every scale, smallest ε first (budget: module docstring);
+    `bands`: the horizon band per ε."""
     rows, blocked, measured = [], None, []
     for case in sorted(cases, key=lambda c: c.eps):
         label = engine if dt is None else f"{engine} dt={dt:g}"
         bar.set_postfix_str(f"{label} eps={case.eps:.3g}", refresh=False)
-        row = engine_row(engine, dt, case, criteria, window, budget_s, measured, blocked)
+        band = bands.get(case.eps)
+        row = engine_row(engine, dt, case, criteria, window, budget_s, measured, blocked, band)
         if row["skipped"] and not blocked:
             blocked = f"skipped: eps={case.eps:.3g} was not run ({row['skipped']})"
         if row["wall_time_s"] and row["steps"]:
@@ -365,7 +421,11 @@ def _alpha_stars(rows: list[dict], plan: list[tuple[str, float | None]]) -> list
     out = []
     for engine, dt in plan:
         mine = [r for r in rows if r["engine"] == engine and r["dt"] == dt]
-        out.append({"engine": engine, "dt": dt, **alpha_star(mine)})
+        star = {"engine": engine, "dt": dt, **alpha_star(mine)}
+        if any(r.get("horizon_pass") is not None for r in mine):
+            judged = [{**r, "passes": r.get("horizon_pass")} for r in mine]
+            star["horizon"] = alpha_star(judged)  # fails only below the band
+        out.append(star)
     return out
 
 

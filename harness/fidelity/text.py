@@ -135,7 +135,22 @@ def _alpha_star_table(doc: dict[str, Any]) -> str:
         "the grid's brackets allow for k\n"
         + table(rows, header, align)
         + "\n\nsmallest inclination passed at all (between it and alpha*, passing depends on "
-        "the exact alpha)\n" + table(low, low_header, align)
+        "the exact alpha)\n" + table(low, low_header, align) + _horizon_table(doc, dts, align)
+    )
+
+
+def _horizon_table(doc: dict[str, Any], dts: list[float | None], align: str) -> str:
+    """alpha* when a run fails only below the horizon band of its scale and dt."""
+    if not any("horizon" in s for s in doc["alpha_star"]):
+        return ""
+    _, rows = per_dt_rows(
+        doc, lambda s: alpha_star_text(s["horizon"]) if "horizon" in s else "-", lambda f: ""
+    )
+    header = ["engine", *[dt_label(d) for d in dts], ""]
+    return (
+        "\n\nalpha* against the horizon (a run fails only when its leading impacts matched "
+        "fall below\nthe 10 % value of the grid model's at that scale and dt; "
+        f"{doc.get('horizon_runs')} grid phases)\n" + table(rows, header, align)
     )
 
 
@@ -159,6 +174,8 @@ def ladder_char(row: dict[str, Any] | None) -> str:
         return "."
     if row["passes"]:
         return "+"
+    if row.get("within_horizon"):
+        return "h"
     return str(min(9, int(10 * (row.get("match_fraction") or 0.0))))
 
 
@@ -179,5 +196,6 @@ def _ladder(doc: dict[str, Any]) -> str:
     header = ["engine", "dt", f"alpha {refs[0]['alpha']:.1e} -> {refs[-1]['alpha']:.1e}"]
     return (
         "each scale, largest alpha first: + passes, 0-9 fails (tenths of the leading impacts\n"
-        "matched), s skipped (budget), . not assessed\n" + table(rows, header, "lll")
+        "matched), h fails but within the horizon band (as good as its dt allows), s skipped\n"
+        "(budget), . not assessed\n" + table(rows, header, "lll")
     )

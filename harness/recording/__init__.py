@@ -9,6 +9,7 @@ One `.rrd` file; the views are laid out by `layout.build_blueprint`, embedded wi
     /<sim>/energy/{log10_excess,kinetic,potential}
     /<sim>/impacts/log              text log of the impacts
     /impacts/<sim>[/first_mismatch] the impact raster (raster.py)
+    /impacts/<sim>/horizon_band     the horizon band beside a lane (horizon.py)
     /singularity/{energy,alpha}/... log-log plots against t_f − t (singularity.py)
     /summary                        markdown summary (summary.py)
 
@@ -89,7 +90,8 @@ def record_comparison(
     if fits[0] is None:
         fits = None
     runs = build_runs(trajs, result.scene, metrics=metrics, fits=fits)
-    return _write(runs, result.scene, path, force=force)
+    horizons = [None, *[r.horizon for r in kept]]
+    return _write(runs, result.scene, path, force=force, horizons=horizons)
 
 
 def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
@@ -107,6 +109,7 @@ def _write(
     path: str | Path,
     contact_tolerance: float | None = None,
     force: bool = False,
+    horizons: list | None = None,
 ) -> Path:
     out = recording_path(path)
     tol = 1e-6 * scene.body.radius if contact_tolerance is None else contact_tolerance
@@ -135,6 +138,10 @@ def _write(
                 log_scene(rec, run, scene, schedule, tol)
                 log_rows(rec, run)
             log_raster(rec, runs, n_contacts, t_max)
+            if horizons is not None:
+                from .horizon import log_horizon_bands
+
+                log_horizon_bands(rec, runs, horizons, n_contacts)
             log_energy_plot(rec, runs, e_plot)
             log_alpha_plot(rec, runs, a_plot)
             text = summary_markdown(runs, scene, t_max)

@@ -64,6 +64,7 @@ def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
                 num(e["impact_time_error"], ".2e"),
                 num(c, ".3f"),
                 num(e["wall_time_s"], ".3g"),
+                *_horizon_cells(e.get("horizon")),
             ]
         )
     parts.append(
@@ -78,6 +79,9 @@ def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
                 "t err [s]",
                 "c",
                 "wall [s]",
+                "band (a)",
+                "own error",
+                "band (b)",
             ],
             rows,
             "runs against the reference (docs/output.md defines every column)",
@@ -88,8 +92,42 @@ def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
     first = doc.get("first_to_diverge")
     if first:
         parts.append(paragraph(f"First to diverge: {first['why']}"))
+    parts.append(_horizon_paragraphs(doc))
     parts.append(recording_link(doc.get("recording"), out_dir))
     return "\n".join(parts)
+
+
+def _band(q: list[float] | None) -> str:
+    if not q:
+        return "-"
+    return f"{q[0]:.0f}–{q[2]:.0f} (median {q[1]:.0f})"
+
+
+def _horizon_cells(h: dict[str, Any] | None) -> list[Any]:
+    """band (a) with its verdict as the cell's class, own error, band (b)."""
+    if not h:
+        return ["-", "-", "-"]
+    a: Any = _band(h.get("matched_quantiles"))
+    if h.get("within") is not None:
+        a = Cell(a, "pass" if h["within"] else "fail", "within" if h["within"] else "below")
+    return [a, num(h.get("own_error"), ".2e"), _band(h.get("own_error_quantiles"))]
+
+
+def _horizon_paragraphs(doc: dict[str, Any]) -> str:
+    """The horizon sentences (docs/fidelity.md, "Horizon"), or nothing without them."""
+    rows = [e["horizon"] for e in doc["engines"] if e.get("horizon")]
+    if not rows:
+        return ""
+    rate = rows[0].get("lyapunov_per_impact")
+    head = paragraph(
+        "Horizon: band (a) is the leading impacts the exact model matches with its impacts on "
+        "the run's step grid (10–90 % of random grid phases); band (b) the exact model "
+        "perturbed at the run's own error; a separation grows by e^λ per impact, λ = "
+        + num(rate, ".3g")
+    )
+    return "\n".join(
+        [head, *[paragraph(h["sentence"], "verdict") for h in rows if h.get("sentence")]]
+    )
 
 
 def recording_link(path: str | None, out_dir: Path) -> str:
@@ -228,6 +266,7 @@ def fidelity_section(doc: dict[str, Any]) -> str:
             "the exact α (the transition band)",
         )
     )
+    parts.append(_horizon_star_table(doc, dts))
     parts.append(figure(alpha_star_figure(doc), f"alpha* against dt on {doc['scene']}"))
     parts.append(_ladder_table(doc, ladder_cell))
     parts.append(figure(matched_figure(doc), f"leading impacts matched on {doc['scene']}"))
@@ -242,6 +281,30 @@ def fidelity_section(doc: dict[str, Any]) -> str:
             )
         )
     return "\n".join(parts)
+
+
+def _horizon_star_table(doc: dict[str, Any], dts: list) -> str:
+    """α* when a run fails only below the horizon band (fidelity --horizon-runs)."""
+    from ..fidelity.text import alpha_star_text, dt_label
+
+    if not any("horizon" in s for s in doc["alpha_star"]):
+        return ""
+    rows = []
+    for engine in doc["engines"]:
+        by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
+        cells = [
+            Cell(alpha_star_text(s["horizon"]), _star_class(s["horizon"]), s["horizon"]["bound"])
+            if (s := by_dt.get(d)) and "horizon" in s
+            else "-"
+            for d in dts
+        ]
+        rows.append([engine, *cells])
+    return table(
+        ["engine", *[dt_label(d) for d in dts]],
+        rows,
+        "α* against the horizon: a run fails only when its leading impacts matched fall below "
+        "the 10 % value of the grid model's at that scale and dt",
+    )
 
 
 def _star_class(star: dict[str, Any]) -> str:
