@@ -34,9 +34,6 @@ TEMP_PREFIX = ".harness-tmp-"
 DEFAULT_NAME_MAX = 255
 
 
-DEFAULT_RECORDING_FOLDER = Path("recordings")
-
-
 class OutputError(Exception):
     """An output that cannot or must not be written: one line, exit status 2."""
 
@@ -68,13 +65,14 @@ def check_writable(
     return p
 
 
-def recording_path(path: str | Path) -> Path:
-    """Where to write: a bare file name (no folder, not even ./) goes under recordings/.
-    Folders are created when the recording is written (harness.outputs.atomic_write)."""
-    p = Path(path)
-    if "/" not in str(path) and os.sep not in str(path):
-        p = DEFAULT_RECORDING_FOLDER / p
-    return p
+RECORDING_SUFFIXES = (".rrd",)
+
+
+def check_recording_path(
+    path: str | os.PathLike, force: bool = False, inputs: Sequence[str | os.PathLike] = ()
+) -> Path:
+    """`--record PATH`: a writable `.rrd` name (check_writable)."""
+    return check_writable(path, force, inputs, what="--record", suffixes=RECORDING_SUFFIXES)
 
 
 def check_directory(path: str | os.PathLike, what: str = "output directory") -> Path:

@@ -21,7 +21,7 @@ import pytest
 import rerun as rr
 
 from harness.cli import main
-from harness.recording import entity_names, record_trajectories, recording_path
+from harness.recording import entity_names, record_trajectories
 from harness.recording.geometry import (
     contact_points,
     exaggerated_pose,
@@ -329,14 +329,6 @@ def test_compare_records_its_runs_with_their_verdicts(tmp_path, capsys):
 
 
 # ----------------------------------------------------------------------------- names, paths
-
-
-def test_bare_file_name_goes_under_recordings(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    assert recording_path("run.rrd") == Path("recordings/run.rrd")
-    assert recording_path("./run.rrd") == Path("run.rrd")
-    assert recording_path("out/deep/run.rrd") == Path("out/deep/run.rrd")
-    assert not (tmp_path / "recordings").exists()  # created only when a recording is written
 
 
 def test_recording_creates_its_folders_when_written(tmp_path):

@@ -65,9 +65,10 @@ def check_outputs(args) -> None:
 
     check_distinct([args.plot, args.out])
     inputs = scene_inputs(args)
-    for path in (args.plot, args.out):
-        if path:
-            check_writable(path, force=args.force, inputs=inputs)
+    if args.plot:
+        check_writable(args.plot, force=args.force, inputs=inputs, what="--plot")
+    if args.out:
+        check_writable(args.out, args.force, inputs, what="--out", suffixes=(".json",))
     if args.plot:
         check_plot_format(args.plot)
 

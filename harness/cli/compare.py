@@ -36,7 +36,7 @@ def register(sub) -> None:
     c.add_argument(
         "--record",
         metavar="FILE.rrd",
-        help="also write a rerun recording of all runs (a bare file name goes under recordings/)",
+        help="also write a rerun recording of all runs to FILE.rrd",
     )
     c.add_argument(
         "--wide",
@@ -55,7 +55,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..compare import compare, format_compare
-    from ..outputs import check_distinct, check_writable
+    from ..outputs import check_distinct
     from ..provenance import attach
     from ..simulators import check_engine, check_run
 
@@ -71,10 +71,10 @@ def run(args) -> int:
             check_run(e, scene, dt, args.t_end, args.max_steps)
     check_run("reference", scene, None, args.t_end)
     if args.record:
-        from ..outputs import recording_path
+        from ..outputs import check_recording_path
 
-        check_writable(recording_path(args.record), args.force, scene_inputs(args))
-        check_distinct([recording_path(args.record), args.out])
+        check_recording_path(args.record, args.force, scene_inputs(args))
+        check_distinct([args.record, args.out])
     recording = None
     result = compare(
         scene, args.engine, dts=args.dt, t_end=args.t_end, progress=log, max_steps=args.max_steps

@@ -29,7 +29,7 @@ import rerun as rr
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
-from ..outputs import atomic_write, recording_path
+from ..outputs import atomic_write
 from .geometry import exaggeration_schedule
 from .layout import SUMMARY, RowRanges, build_blueprint, value_range
 from .raster import log_raster, raster_range
@@ -51,7 +51,6 @@ __all__ = [
     "entity_names",
     "record_comparison",
     "record_trajectories",
-    "recording_path",
 ]
 
 
@@ -108,7 +107,7 @@ def _write(
     contact_tolerance: float | None = None,
     force: bool = False,
 ) -> Path:
-    out = recording_path(path)
+    out = Path(path)
     tol = 1e-6 * scene.body.radius if contact_tolerance is None else contact_tolerance
     ref = runs[0]
     schedule = exaggeration_schedule(ref.trajectory.t, ref.alpha)
