@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from .common import (
+    BadInput,
     add_dt,
     add_engine,
     add_force,
@@ -28,7 +29,7 @@ def register(sub) -> None:
         "(exit status 130).",
     )
     add_scene(c)
-    add_engine(c, many="at least one", required=True)
+    add_engine(c, many="at least one")
     add_dt(c, many="default: 1e-4")
     add_t_end(c)
     add_scale(c)
@@ -57,8 +58,13 @@ def run(args) -> int:
     from ..compare import compare, format_compare
     from ..outputs import check_distinct
     from ..provenance import attach
-    from ..simulators import check_engine, check_run
+    from ..simulators import check_engine, check_run, engine_names
 
+    if not args.engine:
+        raise BadInput(
+            "compare needs --engine E (repeat for several); installed: "
+            + ", ".join(e for e in engine_names() if e != "reference")
+        )
     for e in args.engine:
         check_engine(e)
     if args.out:  # before minutes of simulation, not after

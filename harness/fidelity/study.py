@@ -119,7 +119,7 @@ class ScaleCase:
 
 def scale_case(scene: Scene, eps: float, criteria: FidelityCriteria) -> ScaleCase:
     """Scale the scene by ε (t_end by ε too) and run the reference on it."""
-    scaled = scene.scaled(eps)
+    scaled = scene.scaled(eps, name="fidelity")
     scaled = scaled.with_run(t_end=eps * scene.run.t_end)
     start = time.perf_counter()
     ref = run_simulator("reference", scaled, t_end=scaled.run.t_end)

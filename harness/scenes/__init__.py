@@ -19,12 +19,24 @@ def builtin_names() -> list[str]:
 def resolve_scene(arg: str) -> Scene:
     """SCENE is a path to a scene file or the name of a built-in scene."""
     path = scene_file(arg)
+    if path is not None and path.stem in builtin_names() and not _exists(path):
+        raise SceneError(
+            f"scene file not found: {show_path(arg)}; the built-in scene is named "
+            f"{path.stem!r} (without .toml)"
+        )
     if path is None:
         raise SceneError(
             f"no scene file or built-in scene named {show_path(arg)!r} "
             f"(built-ins: {', '.join(builtin_names())})"
         )
     return load_scene(path)
+
+
+def _exists(path: Path) -> bool:
+    try:
+        return path.exists()
+    except (OSError, ValueError):  # name too long, a NUL character, ...: load_scene says
+        return True
 
 
 def scene_file(arg: str) -> Path | None:

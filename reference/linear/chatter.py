@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from ..core.tolerances import TINY
-from ._text import CHATTER_LEGEND, table
+from ._text import CHATTER_LEGEND, CHATTER_LEGEND_NO_TABLE, table
 from .model import LinearModel
 
 
@@ -219,7 +219,7 @@ def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
 
 def format_chatter(doc: dict) -> str:
     """The eigenvalues, CC/PCC, the rod's thresholds and the self-similar pairs, then
-    CHATTER_LEGEND."""
+    its legend (CHATTER_LEGEND, without the table's part when there is no table)."""
     lines = [
         f"chatter (no gravity): n = {doc['n']}, rho = {doc['gyration']}, "
         f"gamma = {doc['restitution']}",
@@ -254,5 +254,5 @@ def format_chatter(doc: dict) -> str:
             if cl is not None
             else "c_lin = -"
         )
-    lines += ["", CHATTER_LEGEND]
+    lines += ["", CHATTER_LEGEND if doc.get("pairs") else CHATTER_LEGEND_NO_TABLE]
     return "\n".join(lines)
