@@ -121,15 +121,16 @@ def check_engine(name: str) -> str:
 
 def run_simulator(
     engine: str,
-    scene: Scene,
+    scene: Scene | str,
     dt: float | None = None,
     t_end: float | None = None,
     *,
     max_steps: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
-    """Run one simulator on one scene.  `dt` applies to fixed-step engines only, which
-    get DEFAULT_DT when it is None; other engines get dt = None.
+    """Run one simulator on one scene (a Scene, a file or a built-in name).  `dt`
+    applies to fixed-step engines only, which get DEFAULT_DT when it is None; other
+    engines get dt = None.
 
     Before the run, `check_run` (SceneError on bad input).  `progress(done, total)`
     reaches engines that report progress (their `reports_progress` attribute).  After
@@ -137,8 +138,11 @@ def run_simulator(
     unit norm, a body through the ground) ends the run `failed` there.  An engine that
     raises (e.g. MuJoCo refusing a mass below its 1e-15 floor) gives a `failed` run with
     the error as its message and the traceback's end in stats["error"]."""
+    from reference.scenes import as_scene
+
     from .guard import guard_trajectory
 
+    scene = as_scene(scene)
     simulate = load_engine(engine)
     step = check_run(engine, scene, dt, t_end, max_steps)
     extra = {}

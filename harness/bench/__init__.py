@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from reference.scene import Scene, SceneError
+from reference.scenes import as_scene
 from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
@@ -157,7 +158,7 @@ def score(
 
 
 def bench(
-    scene: Scene,
+    scene: Scene | str,
     engines: Sequence[str] | None = None,
     dts: Sequence[float] | None = None,
     t_end: float | None = None,
@@ -175,8 +176,10 @@ def bench(
     "reference" is among `engines`.  dts: timesteps for the fixed-step engines (default
     `DEFAULT_DTS`).  budget_s: a setting whose predicted cost (repeats × predicted
     single-run time) exceeds it is skipped, and so are the finer timesteps after it.
-    reference_settings: (contact_rtol, chatter_tol) pairs; the truth is always `TRUTH`."""
+    reference_settings: (contact_rtol, chatter_tol) pairs; the truth is always `TRUTH`.
+    `scene` may be a Scene, a file or a built-in name."""
     say = progress or (lambda _msg: None)
+    scene = as_scene(scene)
     if repeats < 1:
         raise SceneError(f"--repeats must be >= 1, got {repeats}")
     engines = list(engines) if engines else engine_names()

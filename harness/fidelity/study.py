@@ -30,6 +30,7 @@ import numpy as np
 
 from reference.exponent import ExponentFit
 from reference.scene import Scene, SceneError
+from reference.scenes import as_scene
 from reference.trajectory import Trajectory
 
 from ..bench import predict_time
@@ -284,7 +285,7 @@ def predict_run_time(
 
 
 def fidelity(
-    scene: Scene,
+    scene: Scene | str,
     engines: Sequence[str] | None = None,
     dts: Sequence[float] | None = None,
     eps: Sequence[float] | None = None,
@@ -295,8 +296,10 @@ def fidelity(
 ) -> dict[str, Any]:
     """The fidelity study of `scene` (module docstring; definitions in harness.fidelity).
     Returns the JSON document: criteria, the reference at every scale, one row per
-    engine, dt and scale, α* per engine and dt, the power-law fit per engine."""
+    engine, dt and scale, α* per engine and dt, the power-law fit per engine.  `scene`
+    may be a Scene, a file or a built-in name."""
     say = progress or (lambda _msg: None)
+    scene = as_scene(scene)
     criteria = criteria or FidelityCriteria()
     if criteria.leading < 1:
         raise SceneError(f"--leading must be >= 1, got {criteria.leading}")
