@@ -190,7 +190,7 @@ def check_run(
     (DEFAULT_MAX_STEPS).  Returns the timestep the engine gets (None: not fixed-step)."""
     simulate = load_engine(engine)
     if dt is not None and not (math.isfinite(dt) and dt > 0):
-        raise SceneError(f"--dt must be > 0, got {dt}")
+        raise SceneError(f"dt must be > 0, got {dt}")
     if t_end is not None:
         scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
     limit = getattr(simulate, "max_vertices", None)
@@ -203,13 +203,14 @@ def check_run(
         return None
     horizon = scene.run.t_end
     if step > horizon:
-        raise SceneError(f"--dt ({step:g}) must not exceed t_end ({horizon:g})")
+        raise SceneError(f"dt ({step:g} s) must not exceed t_end ({horizon:g} s)")
     ceiling = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     steps = horizon / step
     if steps > ceiling:
         raise SceneError(
             f"t_end / dt = {horizon:g} / {step:g} = {steps:.3g} steps exceeds the ceiling of "
-            f"{ceiling:g}; use a larger --dt, a shorter --t-end, or raise --max-steps"
+            f"{ceiling:g} steps; use a larger dt or a shorter t_end"
+            + ("" if max_steps is None else " (or raise --max-steps)")
         )
     return step
 
