@@ -40,16 +40,25 @@ def loglog_interp(x: float, xs: Sequence[float], ys: Sequence[float]) -> tuple[f
     return math.exp(ly0 + (math.log(x) - lx0) / (lx1 - lx0) * (ly1 - ly0)), "interpolated"
 
 
+def counted(row: dict[str, Any]) -> bool:
+    """Whether a row enters the derived numbers: it did not fail and it follows the
+    reference (harness.metrics.follows; rows of older documents without the field
+    count)."""
+    return row["status"] != "failed" and row.get("follows_reference", True)
+
+
 def _curve(rows: list[dict[str, Any]], engine: str, metric: str) -> list[tuple[float, float]]:
     pts = []
     for r in rows:
-        if r["engine"] == engine and r.get(metric) is not None and r["status"] != "failed":
+        if r["engine"] == engine and r.get(metric) is not None and counted(r):
             pts.append((float(r["wall_time_s"]), max(float(r[metric]), ERROR_FLOOR)))
     return pts
 
 
 def derive(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """Per error metric and non-reference simulator (Pareto fronts, `loglog_interp`):
+    """Per error metric and non-reference simulator (Pareto fronts, `loglog_interp`),
+    from the rows that follow the reference (`counted`; a simulator without such a row
+    has no entry):
 
     - reference_cost_s: median wall time of the reference at its tightest setting;
     - error_at_reference_cost: the simulator's error on its front at that cost (the

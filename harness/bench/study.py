@@ -38,6 +38,7 @@ from reference.scenes import as_scene
 from reference.trajectory import Status, Trajectory
 
 from ..metrics import evaluate
+from ..metrics.follows import follows_reference
 from ..progress import progress_bar
 from ..simulators import check_engine, check_run, engine_names, is_fixed_step
 from .derive import derive
@@ -116,6 +117,7 @@ def score(
         "attitude_error_agreeing": m.attitude_error_agreeing,
         "first_divergence_time": m.first_divergence_time,
         "divergence_reason": m.divergence_reason,
+        "follows_reference": follows_reference(m.impacts_matched, m.reference_impacts),
     }
 
 

@@ -203,6 +203,14 @@ def add_dt(p: argparse.ArgumentParser, many: str | None = None) -> None:
         p.add_argument("--dt", type=timestep, metavar="DT", help=text)
 
 
+def add_wide(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--wide",
+        action="store_true",
+        help="every column in the terminal table (wider than 100 characters)",
+    )
+
+
 def add_scale(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--scale",

@@ -12,6 +12,7 @@ from .common import (
     add_scale,
     add_scene,
     add_t_end,
+    add_wide,
     emit,
     load_scene_arg,
     log,
@@ -39,11 +40,7 @@ def register(sub) -> None:
         metavar="FILE.rrd",
         help="also write a rerun recording of all runs to FILE.rrd",
     )
-    c.add_argument(
-        "--wide",
-        action="store_true",
-        help="every column in the terminal table (wider than 100 characters)",
-    )
+    add_wide(c)
     c.add_argument(
         "--out",
         metavar="FILE",
