@@ -85,7 +85,7 @@ def _case_rows(case, engines, others, dt, budget_s, say, bar) -> list[dict[str, 
     for engine in ["reference", *others]:
         if engine == "reference" and "reference" not in engines:
             continue
-        bar.set_postfix_str(f"{case.name}: {engine} (predicting)", refresh=False)
+        bar.set_postfix_str(f"{case.name}: {engine}, predicting its time", refresh=False)
         if engine == "reference" and ref_skipped:
             note = (
                 f"; ran the first {len(ref.impacts)} impacts (t <= {ref.t_final:.6g}) "
@@ -174,7 +174,7 @@ def _engine_row(
 
     cap = HARD_CAP_FACTOR * budget_s
     guess = "not predicted" if predicted is None else f"predicted {predicted:.3g} s"
-    bar.set_postfix_str(f"{case.name}: {engine} ({guess}, stopped at {cap:g} s)", refresh=True)
+    bar.set_postfix_str(f"{case.name}: {engine}, {guess}, stopped at {cap:g} s", refresh=True)
     row, crashed = run_capped(judged_run, cap, tick=bar.refresh)
     if row is None and crashed is None:
         why = f"stopped at the hard cap of {cap:g} s ({guess}, budget {budget_s:g} s)"
