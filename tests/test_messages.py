@@ -63,3 +63,10 @@ def test_chatter_legend_describes_only_what_is_printed(capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "beta_p = " in out and "spectral radius" not in out and "table (" not in out
+
+
+def test_chatter_without_self_similar_pairs_explains_no_table(capsys):
+    argv = ["analyze", "chatter", "--n", "3", "--gyration", "0.3", "--restitution", "0.5"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "beta_p" not in out and "spectral radius" not in out and "CC" in out

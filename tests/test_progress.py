@@ -61,3 +61,13 @@ def test_stress_says_why_it_skips(capsys):
     err = capsys.readouterr().err
     assert "stress: alpha-1e-12: mujoco skipped: dt (0.0001 s) must not exceed t_end" in err
     assert "--dt" not in err  # an option the user did not give
+
+
+def test_a_long_fixed_step_run_off_a_terminal_gets_plain_lines():
+    from harness.cli.common import StepProgress
+
+    progress = StepProgress("mujoco")
+    progress(10, 100)
+    progress(30, 100)
+    assert isinstance(progress.bar, PlainProgress) and progress.bar.n == 30
+    progress.close()

@@ -49,7 +49,8 @@ table (gravity-free self-similar chatter, one row per pair of eigenvalues):
 {_CHATTER_FACTORS}
   feasible                no contact below the ground, the next vertex reached approaching
   spectral radius         largest |eigenvalue| of the reduced map's Jacobian (< 1: stable)"""
-# With the table of pairs (n >= 3) and without it (the rod: one line of beta_p, beta_q,
-# c_lin); `harness analyze chatter --help` shows the first.
+# With the table of pairs, with the one line of beta_p, beta_q, c_lin (the rod), or with
+# neither (no self-similar chatter); `harness analyze chatter --help` shows the first.
 CHATTER_LEGEND = f"{_CHATTER_OUTPUT}\n{_CHATTER_TABLE}"
 CHATTER_LEGEND_NO_TABLE = f"{_CHATTER_OUTPUT}\n{_CHATTER_FACTORS}"
+CHATTER_LEGEND_OUTPUT_ONLY = _CHATTER_OUTPUT
