@@ -34,9 +34,6 @@ TEMP_PREFIX = ".harness-tmp-"
 DEFAULT_NAME_MAX = 255
 
 
-DEFAULT_RECORDING_FOLDER = Path("recordings")
-
-
 class OutputError(Exception):
     """An output that cannot or must not be written: one line, exit status 2."""
 
@@ -51,30 +48,31 @@ def check_writable(
     """Refuse now what atomic_write would refuse or fail at later (module docstring);
     with `suffixes`, also a name not ending in one of them.  Returns the path."""
     p = _as_path(path, what)
-    if suffixes and p.suffix.lower() not in suffixes:
-        raise OutputError(f"{what} {show(p)}: the file name must end in {' or '.join(suffixes)}")
     for inp in inputs:
         if _same_file(p, Path(inp)):
             raise OutputError(f"{what} {show(p)} is an input of this command; choose another name")
-    if os.path.lexists(p):
-        if p.is_dir():
-            raise OutputError(f"{what} {show(p)} is a directory; give a file name")
-        if os.path.exists(p) and not p.is_file():
-            raise OutputError(f"{what} {show(p)} is not a regular file (a device, a pipe, ...)")
-        if not force:
-            raise OutputError(f"{what} {show(p)} exists; use --force to replace it")
+    exists = os.path.lexists(p)
+    if exists and p.is_dir():
+        raise OutputError(f"{what} {show(p)} is a directory; give a file name")
+    if exists and os.path.exists(p) and not p.is_file():
+        raise OutputError(f"{what} {show(p)} is not a regular file (a device, a pipe, ...)")
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise OutputError(f"{what} {show(p)}: the file name must end in {' or '.join(suffixes)}")
+    if exists and not force:
+        raise OutputError(f"{what} {show(p)} exists; use --force to replace it")
     _check_names(p, what)
     _probe_folder(p, what)
     return p
 
 
-def recording_path(path: str | Path) -> Path:
-    """Where to write: a bare file name (no folder, not even ./) goes under recordings/.
-    Folders are created when the recording is written (harness.outputs.atomic_write)."""
-    p = Path(path)
-    if "/" not in str(path) and os.sep not in str(path):
-        p = DEFAULT_RECORDING_FOLDER / p
-    return p
+RECORDING_SUFFIXES = (".rrd",)
+
+
+def check_recording_path(
+    path: str | os.PathLike, force: bool = False, inputs: Sequence[str | os.PathLike] = ()
+) -> Path:
+    """`--record PATH`: a writable `.rrd` name (check_writable)."""
+    return check_writable(path, force, inputs, what="--record", suffixes=RECORDING_SUFFIXES)
 
 
 def check_directory(path: str | os.PathLike, what: str = "output directory") -> Path:

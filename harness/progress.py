@@ -1,11 +1,15 @@
-"""Progress bars for long runs (tqdm on stderr), one way for every command.
+"""Progress of long runs, one way for every command.
 
-Shown when stderr is a terminal: a bar in a file or a pipe is a stream of carriage
-returns, and there -v/--verbose gives one progress line per run instead (a long
-background run: `nohup harness fidelity ... -v 2> log`).  A caller may force a bar
-(`show=True`, e.g. the sweep, which draws one in files too): it is redrawn at most every
-0.5 s on a terminal and every 10 s otherwise.  While a bar is shown, our loggers' lines
-go through `tqdm.write` so that they do not break it (`logging_redirect_tqdm`).
+On a terminal: a tqdm bar on stderr, redrawn at most every 0.5 s.  Elsewhere (a log
+file, CI, a notebook): plain lines (`PlainProgress`), the first once the work has taken
+PLAIN_FIRST_S, then one every PLAIN_EVERY_S, each with the count done, the time spent,
+an estimate of what is left (time per item so far × items left) and what is running now;
+quick commands print none.  A caller may force a tqdm bar (`show=True`, e.g. the sweep,
+which draws one in files too: redrawn every 10 s there) or hide it (`show=False`).
+While a bar is shown, our loggers' lines go through `tqdm.write` so that they do not
+break it (`logging_redirect_tqdm`); `bar.write(line)` prints a line that must be seen
+(e.g. why a run is skipped) in every mode (pass file=sys.stderr: tqdm's default is
+stdout).
 """
 
 from __future__ import annotations
@@ -13,7 +17,8 @@ from __future__ import annotations
 import contextlib
 import logging
 import sys
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -23,6 +28,8 @@ if TYPE_CHECKING:
 LOGGERS = ("harness", "engines", "reference")
 REFRESH_TERMINAL_S = 0.5
 REFRESH_FILE_S = 10.0
+PLAIN_FIRST_S = 5.0
+PLAIN_EVERY_S = 15.0
 
 
 def bars_wanted() -> bool:
@@ -33,13 +40,18 @@ def bars_wanted() -> bool:
 @contextlib.contextmanager
 def progress_bar(
     total: int, desc: str, unit: str = "run", show: bool | None = None, initial: int = 0
-) -> Iterator[tqdm]:
-    """A tqdm bar on stderr (module docstring); `show` None means `bars_wanted()`.  A
-    hidden bar still counts, so callers update it unconditionally."""
+) -> Iterator[tqdm | PlainProgress]:
+    """A tqdm bar on stderr when `show` (None: when stderr is a terminal), else plain
+    lines (module docstring).  Both count, so callers update unconditionally."""
+    if show is None and not bars_wanted():
+        plain = PlainProgress(total, desc, unit, initial=initial)
+        with plain:
+            yield plain
+        return
     from tqdm import tqdm
     from tqdm.contrib.logging import logging_redirect_tqdm
 
-    shown = bars_wanted() if show is None else show
+    shown = bool(show) or show is None
     tqdm.monitor_interval = 0  # no monitor thread: some callers fork worker processes
     bar = tqdm(
         total=total,
@@ -58,48 +70,90 @@ def progress_bar(
         yield bar
 
 
-class _Lines:
-    """A counter that prints one plain line to stderr at most every `every` seconds (and
-    at the end): progress of a long run in a log file without carriage returns."""
+class PlainProgress:
+    """The part of tqdm's interface the commands use, as plain lines on stderr for
+    output that is not a terminal (module docstring):
 
-    def __init__(self, total: int, desc: str, unit: str, every: float) -> None:
-        import time
+        stress: 14/80 runs, 2 min 10 s so far, about 10 min left; now alpha-1e-12: drake
+        (predicted 4.4 s; running for 45 s)
 
-        self.total, self.desc, self.unit, self.every = total, desc, unit, every
-        self.n = 0
-        self._clock = time.perf_counter
-        self.start = self.last = self._clock()
+    `clock` and `out` are for tests."""
+
+    def __init__(
+        self,
+        total: int,
+        desc: str,
+        unit: str = "run",
+        initial: int = 0,
+        clock: Callable[[], float] = time.monotonic,
+        out=None,
+    ) -> None:
+        self.total, self.desc, self.unit = total, desc, unit
+        self.n = self.initial = initial
+        self.clock = clock
+        self.out = out
+        self.start = self.now_since = clock()
+        self.next_line = self.start + PLAIN_FIRST_S
+        self.now = ""
+        self.printed = False
+
+    def __enter__(self) -> PlainProgress:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     def update(self, k: int = 1) -> None:
         self.n += k
-        now = self._clock()
-        if now - self.last >= self.every:
-            self.last = now
-            self._line(now)
+        self.refresh(due_only=True)
 
-    def _line(self, now: float) -> None:
-        print(
-            f"{self.desc}: {self.n}/{self.total} {self.unit}s, {now - self.start:.0f} s",
-            file=sys.stderr,
-            flush=True,
-        )
+    def set_postfix_str(self, s: str = "", refresh: bool = True) -> None:
+        if s != self.now:
+            self.now, self.now_since = s, self.clock()
+        self.refresh(due_only=True)
+
+    def set_postfix(self, ordered_dict=None, refresh: bool = True, **kwargs) -> None:
+        items = {**(ordered_dict or {}), **kwargs}
+        self.set_postfix_str(", ".join(f"{k}={v}" for k, v in items.items()))
+
+    def refresh(self, due_only: bool = True) -> None:
+        """Print the progress line if one is due (every PLAIN_EVERY_S)."""
+        t = self.clock()
+        if due_only and t < self.next_line:
+            return
+        self.next_line = t + PLAIN_EVERY_S
+        self.write(self.line(t))
+        self.printed = True
+
+    def line(self, t: float) -> str:
+        done = self.n - self.initial
+        spent = t - self.start
+        text = f"{self.desc}: {self.n}/{self.total} {self.unit}s, {duration(spent)} so far"
+        if 0 < done and self.n < self.total:
+            text += f", about {duration(spent / done * (self.total - self.n))} left"
+        if self.now and self.n < self.total:
+            text += f"; now {self.now} (for {duration(t - self.now_since)})"
+        return text
+
+    def write(self, line: str, file=None) -> None:
+        """tqdm.write's signature (callers pass file=sys.stderr: tqdm's default is stdout)."""
+        print(line, file=self.out or file or sys.stderr, flush=True)
 
     def close(self) -> None:
-        if self.n:
-            self._line(self._clock())
+        """A last line (done, total time) when any line was printed."""
+        if self.printed:
+            t = self.clock()
+            self.write(
+                f"{self.desc}: {self.n}/{self.total} {self.unit}s in {duration(t - self.start)}"
+            )
+            self.printed = False
 
 
-@contextlib.contextmanager
-def progress_counter(total: int, desc: str, unit: str = "run") -> Iterator:
-    """Progress of a long grid, always shown: a tqdm bar on a terminal, else a plain line
-    every REFRESH_FILE_S seconds and one at the end (no carriage returns in a log).
-    The object yielded has `update(k)`."""
-    if bars_wanted():
-        with progress_bar(total, desc, unit, show=True) as bar:
-            yield bar
-        return
-    lines = _Lines(total, desc, unit, REFRESH_FILE_S)
-    try:
-        yield lines
-    finally:
-        lines.close()
+def duration(seconds: float) -> str:
+    """'45 s', '2 min 10 s', '1 h 05 min' (the precision a person reads in a log)."""
+    s = max(0, round(seconds))
+    if s < 60:
+        return f"{s} s"
+    if s < 3600:
+        return f"{s // 60} min {s % 60} s"
+    return f"{s // 3600} h {s % 3600 // 60:02d} min"

@@ -124,15 +124,16 @@ def check_engine(name: str) -> str:
 
 def run_simulator(
     engine: str,
-    scene: Scene,
+    scene: Scene | str,
     dt: float | None = None,
     t_end: float | None = None,
     *,
     max_steps: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> Trajectory:
-    """Run one simulator on one scene.  `dt` applies to fixed-step engines only, which
-    get DEFAULT_DT when it is None; other engines get dt = None.
+    """Run one simulator on one scene (a Scene, a file or a built-in name).  `dt`
+    applies to fixed-step engines only, which get DEFAULT_DT when it is None; other
+    engines get dt = None.
 
     Before the run, `check_run` (SceneError on bad input).  `progress(done, total)`
     reaches engines that report progress (their `reports_progress` attribute).  After
@@ -140,8 +141,11 @@ def run_simulator(
     unit norm, a body through the ground) ends the run `failed` there.  An engine that
     raises (e.g. MuJoCo refusing a mass below its 1e-15 floor) gives a `failed` run with
     the error as its message and the traceback's end in stats["error"]."""
+    from reference.scenes import as_scene
+
     from .guard import guard_trajectory
 
+    scene = as_scene(scene)
     simulate = load_engine(engine)
     step = check_run(engine, scene, dt, t_end, max_steps)
     extra = {}
@@ -189,7 +193,7 @@ def check_run(
     (DEFAULT_MAX_STEPS).  Returns the timestep the engine gets (None: not fixed-step)."""
     simulate = load_engine(engine)
     if dt is not None and not (math.isfinite(dt) and dt > 0):
-        raise SceneError(f"--dt must be > 0, got {dt}")
+        raise SceneError(f"dt must be > 0, got {dt}")
     if t_end is not None:
         scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
     limit = attribute(simulate, "max_vertices")
@@ -202,13 +206,14 @@ def check_run(
         return None
     horizon = scene.run.t_end
     if step > horizon:
-        raise SceneError(f"--dt ({step:g}) must not exceed t_end ({horizon:g})")
+        raise SceneError(f"dt ({step:g} s) must not exceed t_end ({horizon:g} s)")
     ceiling = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     steps = horizon / step
     if steps > ceiling:
         raise SceneError(
             f"t_end / dt = {horizon:g} / {step:g} = {steps:.3g} steps exceeds the ceiling of "
-            f"{ceiling:g}; use a larger --dt, a shorter --t-end, or raise --max-steps"
+            f"{ceiling:g} steps; use a larger dt or a shorter t_end"
+            + ("" if max_steps is None else " (or raise --max-steps)")
         )
     return step
 

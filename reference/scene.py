@@ -138,7 +138,11 @@ class Scene:
         The result passes the same checks as a scene file (check_scene), the
         below-ground check included."""
         if self.initial.q is None or self.initial.p is None:
-            raise SceneError(f"{name} needs a scene whose [initial] is given by q and p")
+            raise SceneError(
+                f"{name} needs a scene whose [initial] is given by q and p (the scaling "
+                f"q -> eps^2 q, p -> eps p acts on linear coordinates); {self.name}'s is "
+                "given by position, rotation_vector, ..."
+            )
         scene = replace(self, initial=scaled_initial(self.initial.q, self.initial.p, eps, name))
         check_scene(scene)
         return scene
@@ -175,7 +179,15 @@ _INITIAL_FULL = {"position", "rotation_vector", "velocity", "angular_velocity"}
 _RUN_KEYS = {"t_end", "max_impacts"}
 
 
-def load_scene(path: str | Path) -> Scene:
+def load_scene(path_or_name: str | Path) -> Scene:
+    """A scene from a file or the name of a built-in scene (reference.scenes:
+    "pentagon-bounce"), validated."""
+    from .scenes import resolve_scene
+
+    return resolve_scene(path_or_name)
+
+
+def load_scene_file(path: str | Path) -> Scene:
     """Read and validate a scene file (a regular UTF-8 TOML file of at most
     MAX_SCENE_FILE_BYTES)."""
     path = Path(path)
@@ -187,6 +199,8 @@ def load_scene(path: str | Path) -> Scene:
             raise SceneError(f"{shown} is not a regular file (a scene is a TOML file)")
         with open(path, "rb") as fh:
             raw = fh.read(MAX_SCENE_FILE_BYTES + 1)
+    except SceneError:
+        raise
     except OSError as exc:
         raise SceneError(f"cannot read scene file {shown}: {exc.strerror or exc}") from None
     except ValueError as exc:  # e.g. a NUL character in the path
@@ -371,9 +385,17 @@ def check_not_below_ground(scene: Scene) -> None:
         raise SceneError("three_point ground needs the body's face normal pointing up")
 
 
+# What a missing required table must give (a message says what to write, docs/contract.md).
+_TABLE_KEYS = {
+    "body": "n (vertices, >= 2) and optionally radius, mass, gyration",
+    "initial": "either q and p (linear coordinates, 3 numbers each) or position, "
+    "rotation_vector, velocity and angular_velocity (3 numbers each)",
+}
+
+
 def _table(name: str, data: dict) -> dict:
     if name not in data:
-        raise SceneError(f"scene has no [{name}] table")
+        raise SceneError(f"scene has no [{name}] table; give {_TABLE_KEYS[name]}")
     return _optional_table(name, data)
 
 

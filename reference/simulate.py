@@ -201,16 +201,20 @@ def run_problem(
 
 
 def simulate(
-    scene: Scene,
+    scene: Scene | str,
     t_end: float | None = None,
     options: ReferenceOptions | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> Trajectory:
-    """Run the exact reference on `scene` until t_end (default scene.run.t_end).
+    """Run the exact reference on `scene` (a Scene, a scene file or a built-in name)
+    until t_end (default scene.run.t_end).
 
     `progress(t)` is called with the time reached whenever the loop returns to Python
     (every `options.work_budget` steps).  stats.wall_time_s is the run alone;
     stats.compile_s the one-time compilation or loading that preceded it."""
+    from .scenes import as_scene
+
+    scene = as_scene(scene)
     opts = options or ReferenceOptions()
     compile_s = load_event_loop()
     t_end = float(t_end if t_end is not None else scene.run.t_end)

@@ -7,7 +7,7 @@
   DT_APART·|v| higher than vertex 0: the two hit DT_APART ≈ 1e-12 s apart.
 
 Run: python scripts/make_scenes.py
-(rewrites harness/scenes/{grazing-contact,near-simultaneous}.toml)
+(rewrites reference/scenes/{grazing-contact,near-simultaneous}.toml)
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from reference.core.flight import flight_constants, free_flight
 from reference.geometry import scene_contact_kinematics
 from reference.scene import Body, Ground, InitialState, Scene
 
-OUT = Path(__file__).resolve().parent.parent / "harness" / "scenes"
+OUT = Path(__file__).resolve().parent.parent / "reference" / "scenes"
 T_GRAZE = 0.1
 DT_APART = 1e-12
 

@@ -21,7 +21,7 @@ import pytest
 import rerun as rr
 
 from harness.cli import main
-from harness.recording import entity_names, record_trajectories, recording_path
+from harness.recording import entity_names, record_trajectories
 from harness.recording.geometry import (
     contact_points,
     exaggerated_pose,
@@ -32,7 +32,8 @@ from harness.recording.geometry import (
     quaternion_xyzw,
     tilt_exaggeration,
 )
-from harness.recording.raster import SIZE_MAX, SIZE_MIN, lane_base, marker_sizes
+from harness.recording.layout import focus_range
+from harness.recording.raster import SIZE_MAX, SIZE_MIN, marker_sizes
 from harness.recording.runs import TIME_MARGIN
 from harness.recording.singularity import EndTime, _ttg, staircase
 from reference import quaternion as qt
@@ -207,18 +208,30 @@ def test_data_end_at_the_reference_end_plus_the_margin(recorded):
     assert len(t_ns) == len(kept) < trajs[1].n_samples
 
 
-def test_raster_has_one_marker_per_impact_in_its_lane(recorded):
+def test_raster_has_one_marker_per_impact_at_its_contact(recorded):
     path, trajs = recorded
     largest = max(e.impulse for traj in trajs for e in traj.impacts)
-    for k, (name, traj) in enumerate(zip(NAMES, trajs, strict=True)):
+    for name, traj in zip(NAMES, trajs, strict=True):
         t_ns, y = scalars(path, f"/impacts/{name}")
         _, sizes = temporal_column(path, f"/impacts/{name}", "SeriesPoints:marker_sizes")
         contacts = np.array([e.contact for e in traj.impacts])
         impulse = np.array([e.impulse for e in traj.impacts])
-        np.testing.assert_array_equal(y, lane_base(k, 3, 5) + contacts)
+        np.testing.assert_array_equal(y, contacts)  # the y axis reads as contact names
         np.testing.assert_array_equal(t_ns, np.round(traj.impact_times() * 1e9).astype(np.int64))
         np.testing.assert_allclose([s[0] for s in sizes], marker_sizes(impulse, largest), rtol=1e-6)
-    assert lane_base(0, 3, 5) > lane_base(1, 3, 5) > lane_base(2, 3, 5) == 0
+
+
+def test_reference_impacts_are_drawn_faintly_behind_the_engines(recorded):
+    path, trajs = recorded
+    t_ns, y = scalars(path, "/impacts/behind/reference")
+    np.testing.assert_array_equal(y, [e.contact for e in trajs[0].impacts])
+    np.testing.assert_array_equal(t_ns, np.round(trajs[0].impact_times() * 1e9).astype(np.int64))
+
+
+def test_rows_open_just_before_the_first_impact():
+    assert focus_range(np.array([0.3, 0.4, 0.5]), 0.5) == pytest.approx((0.29, 0.5))
+    assert focus_range(np.array([]), 0.5) == (0.0, 0.5)  # no impact: the whole run
+    assert focus_range(np.array([0.0, 0.2]), 1.0) == (0.0, 1.0)
 
 
 def test_marker_size_grows_with_log_impulse_over_four_decades():
@@ -232,7 +245,7 @@ def test_first_mismatch_is_marked_where_the_contact_differs(recorded):
     t_ns, y = scalars(path, "/impacts/mujoco_dt1e-03/first_mismatch")
     wrong = trajs[2].impacts[WRONG_CONTACT_AT]
     assert t_ns.tolist() == [round(wrong.t * 1e9)]
-    assert y.tolist() == [lane_base(2, 3, 5) + wrong.contact]
+    assert y.tolist() == [wrong.contact]
     assert "/impacts/mujoco_dt1e-04/first_mismatch" not in entities(path)
     # and on every row of that simulator, at the same time
     t_row, _ = scalars(path, "/mujoco_dt1e-03/divergence/log10_alpha")
@@ -295,7 +308,7 @@ def test_blueprint_is_embedded_with_the_views(recorded):
     series = [d for k, _, d in views if k == "TimeSeries"]
     for row in ("log10 α [rad]", "heading ψ [turns]", "log10(E − E_rest) [J]"):
         assert sum(d.startswith(row) for d in series) == len(NAMES), row
-    assert sum(d.startswith("impacts, lanes top to bottom") for d in series) == 1
+    assert sum(d.startswith("impacts · ") for d in series) == len(NAMES)
 
 
 def test_rerun_rrd_verify_accepts_the_file(recorded):
@@ -329,14 +342,6 @@ def test_compare_records_its_runs_with_their_verdicts(tmp_path, capsys):
 
 
 # ----------------------------------------------------------------------------- names, paths
-
-
-def test_bare_file_name_goes_under_recordings(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    assert recording_path("run.rrd") == Path("recordings/run.rrd")
-    assert recording_path("./run.rrd") == Path("run.rrd")
-    assert recording_path("out/deep/run.rrd") == Path("out/deep/run.rrd")
-    assert not (tmp_path / "recordings").exists()  # created only when a recording is written
 
 
 def test_recording_creates_its_folders_when_written(tmp_path):

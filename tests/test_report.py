@@ -140,6 +140,29 @@ def test_report_shows_each_command_its_versions_and_verdicts(report, results):
     assert len(tags.all("table")) >= 10
 
 
+def test_versions_are_listed_once_for_the_whole_report(report):
+    html = report.read_text()
+    assert html.count("versions (importlib.metadata)") == 1
+    # every result made by this install: its section points at that table
+    assert html.count("Versions: as in the table at the end of the report.") == 5
+
+
+def test_a_section_lists_the_versions_that_differ(results):
+    from harness.report.sections import provenance_section
+
+    doc = json.loads(results["bench"].read_text())
+    shared = dict(doc["provenance"]["versions"])
+    shared["numpy"] = "0.0"  # the report's table says otherwise
+    html = provenance_section(doc, shared_versions=shared)
+    assert "versions that differ" in html and doc["provenance"]["versions"]["numpy"] in html
+
+
+def test_fidelity_ladder_has_one_narrow_column_per_scale(report, results):
+    html = report.read_text()
+    eps = json.loads(results["fidelity"].read_text())["eps"]
+    assert html.count("<th class=v>α ") == len(eps)  # written vertically: fits the page
+
+
 def test_a_sweep_directory_reports_what_its_json_summary_reports(results, tmp_path, capsys):
     from harness.report import load_inputs
 

@@ -10,6 +10,7 @@ import pytest
 from harness import stress as S
 from harness.stress import cases as stress_cases
 from harness.stress import judge as stress_judge
+from harness.stress import study as stress_study
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
 from reference.trajectory import ImpactEvent, Status, Trajectory
 
@@ -168,7 +169,7 @@ def test_real_tiny_case_gives_contract_rows(monkeypatch):
     assert ref["verdict"] == "ok" and ref["missed_impacts"] == 0 and ref["finished"]
 
     # an engine predicted over the budget is listed as skipped, not dropped
-    monkeypatch.setattr(S, "predict_engine_time", lambda *a: 1e9)
+    monkeypatch.setattr(stress_study, "predict_engine_time", lambda *a: 1e9)
     doc = S.stress(engines=["mujoco"], cases=["grazing"], dt=1e-3, budget_s=1.0)
     (row,) = doc["cases"]
     assert row["verdict"] == S.SKIPPED and "budget" in row["reason"]
@@ -181,8 +182,8 @@ def test_run_past_the_hard_cap_is_stopped_and_reported(monkeypatch):
     def slow(*args, **kwargs):
         time.sleep(30.0)
 
-    monkeypatch.setattr(S, "predict_engine_time", lambda *a: None)
-    monkeypatch.setattr(S, "run_simulator", slow)
+    monkeypatch.setattr(stress_study, "predict_engine_time", lambda *a: None)
+    monkeypatch.setattr(stress_study, "run_simulator", slow)
     start = time.perf_counter()
     doc = S.stress(engines=["mujoco"], cases=["grazing"], budget_s=0.3)
     assert time.perf_counter() - start < 10.0
@@ -193,7 +194,7 @@ def test_run_past_the_hard_cap_is_stopped_and_reported(monkeypatch):
 def test_engine_process_dying_is_a_failed_run(monkeypatch):
     import os
 
-    monkeypatch.setattr(S, "predict_engine_time", lambda *a: None)
-    monkeypatch.setattr(S, "run_simulator", lambda *a, **k: os._exit(3))
+    monkeypatch.setattr(stress_study, "predict_engine_time", lambda *a: None)
+    monkeypatch.setattr(stress_study, "run_simulator", lambda *a, **k: os._exit(3))
     (row,) = S.stress(engines=["mujoco"], cases=["grazing"])["cases"]
     assert row["verdict"] == "failed" and "exit code 3" in row["reason"]

@@ -10,6 +10,7 @@ from .common import (
     add_json,
     add_scene,
     add_t_end,
+    add_wide,
     budget,
     emit,
     int_in,
@@ -55,6 +56,7 @@ def register(sub) -> None:
         help="also draw the work-precision curves (format from the suffix: png, pdf, svg)",
     )
     b.add_argument("--out", metavar="FILE.json", help="also write the JSON document to FILE")
+    add_wide(b)
     add_force(b)
     add_json(b)
     b.set_defaults(func=run)
@@ -65,9 +67,10 @@ def check_outputs(args) -> None:
 
     check_distinct([args.plot, args.out])
     inputs = scene_inputs(args)
-    for path in (args.plot, args.out):
-        if path:
-            check_writable(path, force=args.force, inputs=inputs)
+    if args.plot:
+        check_writable(args.plot, force=args.force, inputs=inputs, what="--plot")
+    if args.out:
+        check_writable(args.out, args.force, inputs, what="--out", suffixes=(".json",))
     if args.plot:
         check_plot_format(args.plot)
 
@@ -120,5 +123,5 @@ def run(args) -> int:
     if args.out:
         write_text(args.out, json_text(doc, indent=1), force=args.force)
         note(f"wrote {args.out}")
-    emit(doc, args.json, format_bench(doc))
+    emit(doc, args.json, format_bench(doc, wide=args.wide))
     return 0

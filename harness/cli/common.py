@@ -14,7 +14,6 @@ import math
 import re
 import sys
 import textwrap
-import time
 from typing import Any
 
 from reference.scene import DIMENSION_RANGE, GYRATION_RANGE, MAX_VERTICES, SCALE_RANGE
@@ -206,6 +205,14 @@ def add_dt(p: argparse.ArgumentParser, many: str | None = None) -> None:
         p.add_argument("--dt", type=timestep, metavar="DT", help=text)
 
 
+def add_wide(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--wide",
+        action="store_true",
+        help="every column in the terminal table (wider than 100 characters)",
+    )
+
+
 def add_scale(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--scale",
@@ -304,34 +311,35 @@ finite = json_safe
 
 
 class StepProgress:
-    """`progress(done, total)` for long fixed-step runs: a tqdm bar on stderr, shown at
-    once when stderr is a terminal, else only once the run has taken LONG_RUN_S (then
-    refreshed every 10 s, so that logs stay short)."""
-
-    LONG_RUN_S = 5.0
+    """`progress(done, total)` for long fixed-step runs: a tqdm bar on stderr when it is a
+    terminal, else plain lines (harness.progress.PlainProgress: the first after 5 s, then
+    every 15 s, with the steps done and an estimate of the time left)."""
 
     def __init__(self, label: str) -> None:
         self.label = label
-        self.start = time.perf_counter()
         self.bar = None
 
     def __call__(self, done: int, total: int) -> None:
-        tty = sys.stderr.isatty()
         if self.bar is None:
-            if not tty and time.perf_counter() - self.start < self.LONG_RUN_S:
-                return
-            from tqdm import tqdm
-
-            self.bar = tqdm(
-                total=total,
-                desc=self.label,
-                unit="step",
-                unit_scale=True,
-                file=sys.stderr,
-                mininterval=0.5 if tty else 10.0,
-                dynamic_ncols=True,
-            )
+            self.bar = self._bar(total)
         self.bar.update(done - self.bar.n)
+
+    def _bar(self, total: int):
+        from ..progress import PlainProgress
+
+        if not sys.stderr.isatty():
+            return PlainProgress(total, self.label, unit="step")
+        from tqdm import tqdm
+
+        return tqdm(
+            total=total,
+            desc=self.label,
+            unit="step",
+            unit_scale=True,
+            file=sys.stderr,
+            mininterval=0.5,
+            dynamic_ncols=True,
+        )
 
     def close(self) -> None:
         if self.bar is not None:

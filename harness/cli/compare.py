@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from .common import (
+    BadInput,
     add_dt,
     add_engine,
     add_force,
@@ -12,6 +13,7 @@ from .common import (
     add_scale,
     add_scene,
     add_t_end,
+    add_wide,
     emit,
     load_scene_arg,
     log,
@@ -29,7 +31,7 @@ def register(sub) -> None:
         "(exit status 130).",
     )
     add_scene(c)
-    add_engine(c, many="at least one", required=True)
+    add_engine(c, many="at least one")
     add_dt(c, many="default: 1e-4")
     add_t_end(c)
     add_scale(c)
@@ -37,13 +39,9 @@ def register(sub) -> None:
     c.add_argument(
         "--record",
         metavar="FILE.rrd",
-        help="also write a rerun recording of all runs (a bare file name goes under recordings/)",
+        help="also write a rerun recording of all runs to FILE.rrd",
     )
-    c.add_argument(
-        "--wide",
-        action="store_true",
-        help="every column in the terminal table (wider than 100 characters)",
-    )
+    add_wide(c)
     c.add_argument(
         "--out",
         metavar="FILE",
@@ -57,10 +55,15 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..compare import compare, format_compare
-    from ..outputs import check_distinct, check_writable
+    from ..outputs import check_distinct
     from ..provenance import attach
-    from ..simulators import check_engine, check_run
+    from ..simulators import check_engine, check_run, engine_names
 
+    if not args.engine:
+        raise BadInput(
+            "compare needs --engine E (repeat for several); installed: "
+            + ", ".join(e for e in engine_names() if e != "reference")
+        )
     for e in args.engine:
         check_engine(e)
     if args.out:  # before minutes of simulation, not after
@@ -73,10 +76,10 @@ def run(args) -> int:
             check_run(e, scene, dt, args.t_end, args.max_steps)
     check_run("reference", scene, None, args.t_end)
     if args.record:
-        from ..outputs import recording_path
+        from ..outputs import check_recording_path
 
-        check_writable(recording_path(args.record), args.force, scene_inputs(args))
-        check_distinct([recording_path(args.record), args.out])
+        check_recording_path(args.record, args.force, scene_inputs(args))
+        check_distinct([args.record, args.out])
     recording = None
     result = compare(
         scene,

@@ -87,7 +87,8 @@ def run(args) -> int:
         check_engine(e)
     check_outputs(args)  # before the runs, not after
     scene = load_scene_arg(args)
-    scene.scaled(1.0)  # a scene not given in (q, p) is bad input now, not after the reference
+    # a scene not given in (q, p) is bad input now, not after the reference
+    scene.scaled(1.0, name="fidelity")
     criteria = FidelityCriteria(args.leading, args.match_fraction, args.c_tolerance)
     doc = fidelity(
         scene,

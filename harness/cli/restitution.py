@@ -92,7 +92,7 @@ def _list(xs) -> str:
 
 
 def run(args) -> int:
-    from ..progress import progress_counter
+    from ..progress import progress_bar
     from ..provenance import attach
     from ..restitution.study import run_study
     from ..restitution.text import format_restitution
@@ -101,7 +101,7 @@ def run(args) -> int:
     grid = study_grid(args)
     plots = check_outputs(args, engines)
     total = sum(len(grid.cells(fixed)) for fixed in _fixed(engines))
-    with progress_counter(total, "restitution", unit="impact") as bar:
+    with progress_bar(total, "restitution", unit="impact") as bar:
         doc = run_study(engines, grid, progress=log, tick=bar.update)
     attach(doc, args)
     write_outputs(args, doc, plots)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from .common import (
     StepProgress,
     add_dt,
@@ -40,7 +42,7 @@ def register(sub) -> None:
     s.add_argument(
         "--record",
         metavar="FILE.rrd",
-        help="also write a rerun recording (a bare file name goes under recordings/)",
+        help="also write a rerun recording to FILE.rrd",
     )
     s.add_argument(
         "--out",
@@ -56,19 +58,22 @@ def register(sub) -> None:
 def planned_outputs(args) -> list:
     """The files this run will write, as harness.outputs sees them."""
     from ..io import trajectory_paths
-    from ..outputs import recording_path
 
     paths = trajectory_paths(args.out) if args.out else []
     if args.record:
-        paths.append(recording_path(args.record))
+        paths.append(Path(args.record))
     return paths
 
 
 def check_outputs(args, paths) -> None:
-    from ..outputs import check_distinct, check_writable
+    from ..outputs import check_distinct, check_recording_path, check_writable
 
     check_distinct(paths)
     inputs = scene_inputs(args)
+    if args.out:
+        check_writable(args.out, args.force, inputs, what="--out", suffixes=(".parquet",))
+    if args.record:
+        check_recording_path(args.record, args.force, inputs)
     for path in paths:
         check_writable(path, force=args.force, inputs=inputs)
 

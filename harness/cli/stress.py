@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import add_engine, add_json, budget, emit, log, timestep
+from .common import add_engine, add_json, add_wide, budget, emit, log, timestep
 
 
 def register(sub) -> None:
@@ -36,6 +36,7 @@ def register(sub) -> None:
         metavar="S",
         help="seconds [s] a run may take; runs predicted longer are skipped",
     )
+    add_wide(st)
     add_json(st)
     st.set_defaults(func=run)
 
@@ -47,5 +48,5 @@ def run(args) -> int:
     doc = stress(
         engines=args.engine, cases=args.case, dt=args.dt, progress=log, budget_s=args.budget
     )
-    emit(attach(doc, args), args.json, format_stress(doc))
+    emit(attach(doc, args), args.json, format_stress(doc, wide=args.wide))
     return 0

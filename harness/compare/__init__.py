@@ -16,12 +16,13 @@ are defined in docs/output.md.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from reference.exponent import ExponentFit
 from reference.scene import Scene, SceneError
+from reference.scenes import as_scene
 from reference.trajectory import Trajectory
 
 from ..horizon.settings import DEFAULT_SEED
@@ -97,6 +98,7 @@ class CompareResult:
                 row["horizon"]["sentence"] = horizon_sentence(run)
             engines.append(row)
         return {
+            "kind": "compare",
             "scene": self.scene.name,
             "restitution": self.scene.restitution,
             "reference": ref,
@@ -113,9 +115,9 @@ class CompareResult:
 
 
 def compare(
-    scene: Scene,
-    engines: list[str],
-    dts: list[float] | None = None,
+    scene: Scene | str,
+    engines: str | Sequence[str],
+    dts: float | Sequence[float] | None = None,
     t_end: float | None = None,
     progress: Callable[[str], None] | None = None,
     max_steps: int | None = None,
@@ -124,14 +126,18 @@ def compare(
 ) -> CompareResult:
     """Run the reference once and each engine at each dt (DEFAULT_DT when `dts` is None;
     once for `reference` and `linear`), all to the same t_end, and score every run.
-    Each simulator is warmed up before it is timed.  `progress` gets one line per run
-    with its wall time (for stderr).  An engine run stopped by Ctrl-C stops the
+    `scene` may be a Scene, a file or a built-in name; `engines` and `dts` one value or
+    several.  Each simulator is warmed up before it is timed.  `progress` gets one line
+    per run with its wall time (for stderr).  An engine run stopped by Ctrl-C stops the
     comparison (KeyboardInterrupt).  Then each run but the reference's gets its horizon
     (harness.horizon.verdict) from ensembles of `horizon_runs` members seeded with
     `horizon_seed` (0, the default here: no horizons; the CLI's default is
-    harness.horizon.settings.DEFAULT_RUNS)."""
+    harness.horizon.settings.DEFAULT_RUNS).  `result.to_dict()` is the `compare --json`
+    document (docs/api.md)."""
     say = progress or (lambda _msg: None)
-    dts = list(dts) if dts else [DEFAULT_DT]
+    scene = as_scene(scene)
+    engines = [engines] if isinstance(engines, str) else list(engines)
+    dts = [float(dts)] if isinstance(dts, int | float) else (list(dts) if dts else [DEFAULT_DT])
     plan = [(e, dt) for e in engines for dt in (dts if is_fixed_step(e) else [None])]
     runs: list[EngineRun] = []
     with progress_bar(1 + len(plan), f"compare {scene.name}") as bar:

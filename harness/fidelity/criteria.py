@@ -34,8 +34,11 @@ import numpy as np
 
 from reference.exponent import ordinary_least_squares
 
-DEFAULT_LEADING = 10
-DEFAULT_MATCH_FRACTION = 0.9
+from ..metrics import follows
+from ..metrics.follows import LEADING_IMPACTS, MATCH_FRACTION
+
+DEFAULT_LEADING = LEADING_IMPACTS
+DEFAULT_MATCH_FRACTION = MATCH_FRACTION
 DEFAULT_C_TOLERANCE = 0.1
 
 
@@ -61,8 +64,8 @@ class FidelityCriteria:
 
 
 def impacts_pass(matched: int, leading: int, criteria: FidelityCriteria) -> bool:
-    """matched / leading ≥ match_fraction (with leading ≥ 1)."""
-    return leading > 0 and matched >= criteria.match_fraction * leading - 1e-9
+    """matched / leading ≥ match_fraction (with leading ≥ 1; harness.metrics.follows)."""
+    return follows.impacts_pass(matched, leading, criteria.match_fraction)
 
 
 def exponent_check(

@@ -30,6 +30,7 @@ import numpy as np
 
 from reference.exponent import ExponentFit
 from reference.scene import Scene, SceneError
+from reference.scenes import as_scene
 from reference.trajectory import Trajectory
 
 from ..bench import predict_time
@@ -118,7 +119,7 @@ class ScaleCase:
 
 def scale_case(scene: Scene, eps: float, criteria: FidelityCriteria) -> ScaleCase:
     """Scale the scene by ε (t_end by ε too) and run the reference on it."""
-    scaled = scene.scaled(eps)
+    scaled = scene.scaled(eps, name="fidelity")
     scaled = scaled.with_run(t_end=eps * scene.run.t_end)
     start = time.perf_counter()
     ref = run_simulator("reference", scaled, t_end=scaled.run.t_end)
@@ -328,7 +329,7 @@ def predict_run_time(
 
 
 def fidelity(
-    scene: Scene,
+    scene: Scene | str,
     engines: Sequence[str] | None = None,
     dts: Sequence[float] | None = None,
     eps: Sequence[float] | None = None,
@@ -341,11 +342,13 @@ def fidelity(
 ) -> dict[str, Any]:
     """The fidelity study of `scene` (module docstring; definitions in harness.fidelity).
     Returns the JSON document: criteria, the reference at every scale, one row per
-    engine, dt and scale, α* per engine and dt, the power-law fit per engine.  With
-    `horizon_runs` > 0 each fixed-step row also gets the horizon band of its scale and
-    dt (`horizon_band`, grid phases seeded with `horizon_seed`) and each α* entry a
-    `horizon` α*: the engine fails at a scale only below that band."""
+    engine, dt and scale, α* per engine and dt, the power-law fit per engine.  `scene`
+    may be a Scene, a file or a built-in name.  With `horizon_runs` > 0 each fixed-step
+    row also gets the horizon band of its scale and dt (`horizon_band`, grid phases
+    seeded with `horizon_seed`) and each α* entry a `horizon` α*: the engine fails at a
+    scale only below that band."""
     say = progress or (lambda _msg: None)
+    scene = as_scene(scene)
     criteria = criteria or FidelityCriteria()
     if criteria.leading < 1:
         raise SceneError(f"--leading must be >= 1, got {criteria.leading}")

@@ -51,9 +51,14 @@ def figure_paths(out_dir: Path) -> list[Path]:
 
 def make_figures(out_dir: Path, progress=print) -> dict:
     """Compute and save every figure; returns name → {path, paper, ours, agree}."""
+    from ..progress import progress_bar
+
     out_dir = Path(out_dir)  # created with the first figure (harness.outputs)
     doc = {}
-    for name, fn in FIGURES.items():
-        progress(f"figure {name}")
-        doc[name] = fn(out_dir, progress)
+    with progress_bar(len(FIGURES), "figures", unit="figure") as bar:
+        for name, fn in FIGURES.items():
+            progress(f"figure {name}")
+            bar.set_postfix_str(name, refresh=False)
+            doc[name] = fn(out_dir, progress)
+            bar.update()
     return doc

@@ -8,10 +8,10 @@ One `.rrd` file; the views are laid out by `layout.build_blueprint`, embedded wi
     /<sim>/attitude/{log10_alpha,heading}     rows (rows.py)
     /<sim>/energy/{log10_excess,kinetic,potential}
     /<sim>/impacts/log              text log of the impacts
-    /impacts/<sim>[/first_mismatch] the impact raster (raster.py)
-    /impacts/<sim>/horizon_band     the horizon band beside a lane (horizon.py)
+    /impacts/<sim>[/first_mismatch] the impact rasters (raster.py)
+    /impacts/<sim>/horizon_band     the horizon band above a raster's contacts (horizon.py)
     /singularity/{energy,alpha}/... log-log plots against t_f − t (singularity.py)
-    /summary                        markdown summary (summary.py)
+    /summary, /reading              markdown summary, how to read the views (summary.py)
 
 Everything temporal is on the duration timeline `sim_time`, sent with `send_columns`
 (one call per entity).  The data end at the reference's end + 10 % (runs.time_span).
@@ -30,14 +30,14 @@ import rerun as rr
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
-from ..outputs import atomic_write, recording_path
+from ..outputs import atomic_write
 from .geometry import exaggeration_schedule
-from .layout import SUMMARY, RowRanges, build_blueprint, value_range
+from .layout import READING, SUMMARY, RowRanges, build_blueprint, focus_range, value_range
 from .raster import log_raster, raster_range
 from .rows import SIM_TIME, log10_positive, log_rows, log_scene
 from .runs import RunView, build_runs, entity_names, time_span  # noqa: F401
 from .singularity import alpha_plot, energy_plot, log_alpha_plot, log_energy_plot
-from .summary import summary_markdown
+from .summary import reading_markdown, summary_markdown
 
 if TYPE_CHECKING:
     from ..compare import CompareResult
@@ -52,7 +52,6 @@ __all__ = [
     "entity_names",
     "record_comparison",
     "record_trajectories",
-    "recording_path",
 ]
 
 
@@ -99,7 +98,7 @@ def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
         log_alpha=value_range([log10_positive(r.alpha) for r in runs], max_span=ROW_DECADES),
         heading=value_range([r.psi for r in runs]),
         log_excess=value_range([log10_positive(r.excess) for r in runs], max_span=ROW_DECADES),
-        raster=raster_range(len(runs), n_contacts),
+        raster=raster_range(n_contacts),
     )
 
 
@@ -111,7 +110,7 @@ def _write(
     force: bool = False,
     horizons: list | None = None,
 ) -> Path:
-    out = recording_path(path)
+    out = Path(path)
     tol = 1e-6 * scene.body.radius if contact_tolerance is None else contact_tolerance
     ref = runs[0]
     schedule = exaggeration_schedule(ref.trajectory.t, ref.alpha)
@@ -124,7 +123,8 @@ def _write(
         _row_ranges(runs, n_contacts),
         None if e_plot is None else e_plot.axes,
         None if a_plot is None else a_plot.axes,
-        t_max,
+        focus_range(ref.trajectory.impact_times(), t_max),
+        "bump" if scene.ground.kind == "three_point" else "vertex",
     )
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     if not rr.is_enabled(rec):
@@ -137,7 +137,7 @@ def _write(
             for run in runs:
                 log_scene(rec, run, scene, schedule, tol)
                 log_rows(rec, run)
-            log_raster(rec, runs, n_contacts, t_max)
+            log_raster(rec, runs)
             if horizons is not None:
                 from .horizon import log_horizon_bands
 
@@ -146,6 +146,8 @@ def _write(
             log_alpha_plot(rec, runs, a_plot)
             text = summary_markdown(runs, scene, t_max)
             rec.log(SUMMARY, rr.TextDocument(text, media_type="text/markdown"), static=True)
+            reading = rr.TextDocument(reading_markdown(), media_type="text/markdown")
+            rec.log(READING, reading, static=True)
         finally:
             rec.flush()
             rec.disconnect()  # closes the file sink: footer and manifest are written

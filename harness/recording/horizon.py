@@ -1,7 +1,7 @@
-"""The horizon band beside each engine's lane of the impact raster (raster.py): where
+"""The horizon band in each engine's impact raster (raster.py): where
 the exact model with its impacts on that run's step grid stops matching the reference
 (harness.horizon, level (a): the 10 % … 90 % matched counts), drawn as a thick bar in
-the lane's blank row above its contacts, from the time of the reference's impact at the
+the raster's blank row above its contacts (y = n_contacts), from the time of the reference's impact at the
 10 % count to that at the 90 % count.  A run whose red × (first mismatch) lies left of
 its bar diverged before its timestep forces it to.
 
@@ -14,7 +14,7 @@ import numpy as np
 import rerun as rr
 
 from ..horizon.verdict import Horizon
-from .raster import RASTER, lane_base
+from .raster import RASTER
 from .rows import time_column
 from .runs import RunView
 
@@ -46,14 +46,14 @@ def log_horizon_bands(
     """One band per run that has a level-(a) horizon (module docstring); `horizons` is
     aligned with `runs` (None for the reference and event-driven runs)."""
     t_ref = runs[0].trajectory.impact_times().astype(float)
-    for k, (run, h) in enumerate(zip(runs, horizons, strict=True)):
+    for run, h in zip(runs, horizons, strict=True):
         if h is None or h.matched_quantiles is None:
             continue
         span = band_times(t_ref, h.matched_quantiles)
         if span is None:
             continue
         q = h.matched_quantiles
-        y = lane_base(k, len(runs), n_contacts) + n_contacts - 0.4
+        y = float(n_contacts)
         path = f"{RASTER}/{run.name}/horizon_band"
         verdict = "within" if h.within else "below"
         rec.log(

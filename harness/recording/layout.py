@@ -8,12 +8,15 @@ Left, one column per simulator (reference first), rows sharing the time axis:
     heading ψ      direction of the lowest point of the rim (turns, unwrapped)
     log10 (E − E_rest)   energy above the resting level (J)
 
-Every engine's plot also shows the reference (grey, thinner) behind it.  Under the
-columns, one raster of every simulator's impacts (one lane each).  Right: the two
-log-log plots against t_f − t (energy with the exponent fits, and α), and the summary /
-impact log.  Every time-series view opens on the same time range, [0, reference's end
-+ 10 %], where the data end, so the timeline shows the motion and nothing after it.
-The time panel opens collapsed and paused at t = 0; the side panels collapsed.
+    impacts        the raster: y = contact index, marker size ~ log impulse (raster.py)
+
+Every engine's plot also shows the reference (grey, thinner; in the raster, small faint
+markers) behind it.  Right: the two log-log plots against t_f − t (energy with the
+exponent fits, and α), and the summary / impact log.  Every time-series view opens on
+the same time range (`focus_range`): from just before the reference's first impact
+(the flight before it is a parabola; the impacts are the part to compare) to where the
+data end, the reference's end + 10 %; zooming out shows the whole run.  The time panel
+opens collapsed and paused at t = 0; the side panels collapsed.
 """
 
 from __future__ import annotations
@@ -25,12 +28,13 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from .plot2d import Axes
-from .raster import RASTER
+from .raster import BEHIND, RASTER
 from .rows import SIM_TIME
 from .runs import RunView
 from .singularity import ALPHA, ENERGY
 
 SUMMARY = "/summary"
+READING = "/reading"
 
 
 @dataclass(frozen=True)
@@ -64,19 +68,37 @@ def _axis(r: tuple[float, float] | None) -> rrb.ScalarAxis | None:
     return None if r is None else rrb.ScalarAxis(range=r, zoom_lock=False)
 
 
-def time_axis(t_max: float) -> rrb.TimeAxis:
-    """The shared time axis: every row opens on [0, t_max] (rerun 0.41 ignores a view
-    range on axes linked to the global one, so each view gets the same range)."""
+FOCUS_MARGIN = 0.05  # of the focused span, before the first impact
+
+
+def focus_range(reference_impact_times: np.ndarray, t_max: float) -> tuple[float, float]:
+    """[t0, t_max]: t0 = FOCUS_MARGIN of the span before the reference's first impact
+    (0 without impacts, or when that impact is at the start)."""
+    times = np.asarray(reference_impact_times, dtype=float)
+    times = times[np.isfinite(times) & (times < t_max)]
+    if len(times) == 0:
+        return 0.0, float(t_max)
+    first = float(times.min())
+    return max(0.0, first - FOCUS_MARGIN * (t_max - first)), float(t_max)
+
+
+def time_axis(span: tuple[float, float]) -> rrb.TimeAxis:
+    """The shared time axis: every row opens on `span` (rerun 0.41 ignores a view range
+    on axes linked to the global one, so each view gets the same range)."""
     return rrb.TimeAxis(
         view_range=rr.TimeRange(
-            start=rrb.TimeRangeBoundary.absolute(seconds=0.0),
-            end=rrb.TimeRangeBoundary.absolute(seconds=float(t_max)),
+            start=rrb.TimeRangeBoundary.absolute(seconds=float(span[0])),
+            end=rrb.TimeRangeBoundary.absolute(seconds=float(span[1])),
         )
     )
 
 
 def _row(
-    runs: list[RunView], leaf: str, title: str, y: tuple[float, float] | None, t_max: float
+    runs: list[RunView],
+    leaf: str,
+    title: str,
+    y: tuple[float, float] | None,
+    span: tuple[float, float],
 ) -> rrb.Horizontal:
     """One row: a time-series view per simulator with the reference behind the engines."""
     ref = runs[0]
@@ -92,12 +114,39 @@ def _row(
                 origin="/",
                 contents=contents,
                 name=name,
-                axis_x=time_axis(t_max),
+                axis_x=time_axis(span),
                 axis_y=_axis(y),
                 plot_legend=rrb.PlotLegend(visible=False),
             )
         )
     return rrb.Horizontal(*views, name=title)
+
+
+def _raster_row(
+    runs: list[RunView], contact_word: str, y: tuple[float, float], span: tuple[float, float]
+) -> rrb.Horizontal:
+    """The impacts under each column; an engine's view has the reference's behind."""
+    ref = runs[0]
+    views = []
+    for run in runs:
+        contents = [
+            f"{RASTER}/{run.name}",
+            f"{RASTER}/{run.name}/first_mismatch",
+            f"{RASTER}/{run.name}/horizon_band",
+        ]
+        if not run.is_reference:
+            contents.append(f"{BEHIND}/{ref.name}")
+        views.append(
+            rrb.TimeSeriesView(
+                origin="/",
+                contents=contents,
+                name=f"impacts · {run.label} · y = {contact_word}",
+                axis_x=time_axis(span),
+                axis_y=_axis(y),
+                plot_legend=rrb.PlotLegend(visible=False),
+            )
+        )
+    return rrb.Horizontal(*views, name="impacts")
 
 
 def _scenes(runs: list[RunView], radius: float) -> rrb.Horizontal:
@@ -134,25 +183,18 @@ def build_blueprint(
     ranges: RowRanges,
     energy_axes: Axes | None,
     alpha_axes: Axes | None,
-    t_max: float,
+    focus: tuple[float, float],
+    contact_word: str = "vertex",
 ) -> rrb.Blueprint:
-    """The layout in the module docstring."""
-    lanes = ", ".join(run.label for run in runs)
-    raster = rrb.TimeSeriesView(
-        origin=RASTER,
-        name=f"impacts, lanes top to bottom: {lanes} · y = contact · size ~ log impulse · "
-        "red × = first mismatch",
-        axis_x=time_axis(t_max),
-        axis_y=_axis(ranges.raster),
-        plot_legend=rrb.PlotLegend(visible=False),
-    )
+    """The layout in the module docstring; `contact_word` names the raster's y axis
+    ("vertex" or "bump"), `focus` is the time range every row opens on."""
     columns = rrb.Vertical(
         _scenes(runs, radius),
-        _row(runs, "attitude/log10_alpha", "log10 α [rad]", ranges.log_alpha, t_max),
-        _row(runs, "attitude/heading", "heading ψ [turns]", ranges.heading, t_max),
-        _row(runs, "energy/log10_excess", "log10(E − E_rest) [J]", ranges.log_excess, t_max),
-        raster,
-        row_shares=[1.35, 1.0, 1.0, 1.0, 1.25],
+        _row(runs, "attitude/log10_alpha", "log10 α [rad]", ranges.log_alpha, focus),
+        _row(runs, "attitude/heading", "heading ψ [turns]", ranges.heading, focus),
+        _row(runs, "energy/log10_excess", "log10(E − E_rest) [J]", ranges.log_excess, focus),
+        _raster_row(runs, contact_word, ranges.raster, focus),
+        row_shares=[1.35, 1.0, 1.0, 1.0, 0.9],
         name="simulators side by side",
     )
     side = rrb.Vertical(
@@ -162,6 +204,7 @@ def build_blueprint(
         _plot2d(ALPHA, "α against t_f − t", alpha_axes, 2),
         rrb.Tabs(
             rrb.TextDocumentView(origin=SUMMARY, name="summary"),
+            rrb.TextDocumentView(origin=READING, name="how to read"),
             rrb.TextLogView(
                 origin="/",
                 contents=[f"/{run.name}/impacts/log" for run in runs],
@@ -169,11 +212,11 @@ def build_blueprint(
             ),
             name="summary",
         ),
-        row_shares=[1.35, 1.0, 1.1],
+        row_shares=[1.1, 0.9, 1.5],
         name="near the singularity",
     )
     return rrb.Blueprint(
-        rrb.Horizontal(columns, side, column_shares=[3.0, 1.15]),
+        rrb.Horizontal(columns, side, column_shares=[3.0, 1.3]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
         rrb.TimePanel(timeline=SIM_TIME, state="collapsed", play_state="paused"),

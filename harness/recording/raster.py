@@ -1,21 +1,18 @@
-"""The impact raster: every impact of every simulator as a marker at its time, one lane
-per simulator (the reference on top), the contact index within the lane, the marker's
-size growing with the impulse, and the first impact that disagrees with the reference
-marked by a red cross in that simulator's lane.
+"""The impact rasters: under each simulator's column, its impacts as markers at their
+times, y = the contact's index (vertex k on flat ground, bump k on three bumps), the
+marker's size growing with the impulse; in an engine's raster the reference's impacts
+are drawn behind, small and faint, so a missed, extra or shifted impact shows where
+the two differ; the first impact that disagrees with the reference is marked by a red
+cross.
 
-    /impacts/<sim>                  SeriesPoints, y = lane base + contact index
-    /impacts/lanes/<sim>            a faint guide line under the lane
+    /impacts/<sim>                  SeriesPoints, y = contact index
+    /impacts/behind/<reference>     the reference's impacts again, faint (engines' views)
     /impacts/<sim>/first_mismatch   one red cross at the first mismatch (if any)
     /<sim>/impacts/log              one TextLog line per impact (contact, time, impulse,
                                     normal velocity before → after)
-
-Lane k (0 = reference) occupies y = base_k … base_k + n_contacts − 1 with
-base_k = (lanes − 1 − k)(n_contacts + 1): a blank row separates the lanes.
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 import rerun as rr
@@ -28,9 +25,9 @@ IMPULSE_DECADES = 4.0  # marker size spans this many decades of impulse
 SIZE_MIN, SIZE_MAX = 1.5, 5.5  # marker radius in UI points
 
 
-def lane_base(k: int, lanes: int, n_contacts: int) -> float:
-    """y of contact 0 in lane k (0 = top lane)."""
-    return float((lanes - 1 - k) * (n_contacts + 1))
+BEHIND = f"{RASTER}/behind"
+BEHIND_ALPHA = 110  # of 255: the reference behind an engine's impacts
+BEHIND_SCALE = 0.6  # its markers' size relative to its own raster's
 
 
 def marker_sizes(impulse: np.ndarray, largest: float) -> np.ndarray:
@@ -52,54 +49,46 @@ def largest_impulse(runs: list[RunView]) -> float:
     )
 
 
-def log_raster(rec: rr.RecordingStream, runs: list[RunView], n_contacts: int, t_max: float) -> None:
-    """Every lane, its guide line and the mismatch markers (module docstring)."""
+def log_raster(rec: rr.RecordingStream, runs: list[RunView]) -> None:
+    """Every simulator's impacts, the reference's faint copy and the mismatch markers
+    (module docstring)."""
     biggest = largest_impulse(runs)
-    for k, run in enumerate(runs):
-        base = lane_base(k, len(runs), n_contacts)
-        _log_lane_guide(rec, run, base, t_max)
-        path = f"{RASTER}/{run.name}"
-        rec.log(
-            path,
-            rr.SeriesPoints(
-                colors=[run.color],
-                names=[f"{run.label} (contacts at {base:g} + k)"],
-                markers=["circle"],
-            ),
-            static=True,
-        )
-        imps = run.trajectory.impacts
-        if imps:
-            traj = run.trajectory
-            t = traj.impact_times()
-            y = base + traj.impact_contacts().astype(float)
-            sizes = marker_sizes(traj.impact_column("impulse"), biggest)
-            rec.send_columns(
-                path,
-                [time_column(t)],
-                [
-                    *rr.Scalars.columns(scalars=y),
-                    *rr.SeriesPoints.columns(marker_sizes=sizes),
-                ],
-            )
-        _log_mismatch(rec, run, base)
+    ref = runs[0]
+    _log_impacts(rec, f"{BEHIND}/{ref.name}", ref, biggest, BEHIND_ALPHA, BEHIND_SCALE)
+    for run in runs:
+        _log_impacts(rec, f"{RASTER}/{run.name}", run, biggest)
+        _log_mismatch(rec, run)
         _log_impact_text(rec, run)
 
 
-def _log_lane_guide(rec: rr.RecordingStream, run: RunView, base: float, t_max: float) -> None:
-    """A faint line in the lane's colour under its contact 0, from t = 0 to t_max."""
-    path = f"{RASTER}/lanes/{run.name}"
+def _log_impacts(
+    rec: rr.RecordingStream,
+    path: str,
+    run: RunView,
+    biggest: float,
+    alpha: int = 255,
+    scale: float = 1.0,
+) -> None:
     rec.log(
         path,
-        rr.SeriesLines(colors=[(*run.color, 90)], names=[f"{run.label} lane"], widths=[1.0]),
+        rr.SeriesPoints(colors=[(*run.color, alpha)], names=[run.label], markers=["circle"]),
         static=True,
     )
+    traj = run.trajectory
+    if not traj.impacts:
+        return
+    sizes = scale * marker_sizes(traj.impact_column("impulse"), biggest)
     rec.send_columns(
-        path, [time_column([0.0, t_max])], rr.Scalars.columns(scalars=[base - 0.5, base - 0.5])
+        path,
+        [time_column(traj.impact_times())],
+        [
+            *rr.Scalars.columns(scalars=traj.impact_contacts().astype(float)),
+            *rr.SeriesPoints.columns(marker_sizes=sizes),
+        ],
     )
 
 
-def _log_mismatch(rec: rr.RecordingStream, run: RunView, base: float) -> None:
+def _log_mismatch(rec: rr.RecordingStream, run: RunView) -> None:
     x = None if run.match is None else run.match.mismatch
     if x is None:
         return
@@ -111,7 +100,7 @@ def _log_mismatch(rec: rr.RecordingStream, run: RunView, base: float) -> None:
         static=True,
     )
     t = x.t_run if x.t_run is not None else x.t_ref
-    rec.send_columns(path, [time_column([t])], rr.Scalars.columns(scalars=[base + float(contact)]))
+    rec.send_columns(path, [time_column([t])], rr.Scalars.columns(scalars=[float(contact)]))
 
 
 def _log_impact_text(rec: rr.RecordingStream, run: RunView) -> None:
@@ -132,7 +121,7 @@ def _log_impact_text(rec: rr.RecordingStream, run: RunView) -> None:
     )
 
 
-def raster_range(lanes: int, n_contacts: int) -> tuple[float, float]:
-    """y range that shows every lane with a margin."""
-    top = lane_base(0, lanes, n_contacts) + n_contacts - 1
-    return -0.8, top + 0.8 if math.isfinite(top) else 1.0
+def raster_range(n_contacts: int) -> tuple[float, float]:
+    """y range that shows every contact with a margin, and the row y = n_contacts above
+    them where the horizon band is drawn (horizon.py)."""
+    return -0.6, n_contacts + 0.6

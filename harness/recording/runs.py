@@ -81,7 +81,7 @@ def entity_names(trajs: list[Trajectory]) -> list[str]:
         if traj.dt is not None:
             base += f"_dt{traj.dt:.0e}"
         name, k = base, 2
-        while name in names or name in ("impacts", "lanes", "singularity", "summary"):
+        while name in names or name in ("impacts", "behind", "singularity", "summary", "reading"):
             name, k = f"{base}_{k}", k + 1
         names.append(name)
     return names

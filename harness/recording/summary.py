@@ -71,15 +71,22 @@ def summary_markdown(runs: list[RunView], scene: Scene, t_max: float) -> str:
         _first_line(runs, scene),
         "",
         *[_run_line(run, scene) for run in runs],
-        "",
+    ]
+    return "\n".join(lines)
+
+
+def reading_markdown() -> str:
+    """How to read the views (its own tab beside the summary, so that neither is cut)."""
+    return (
         "**Reading the views.** Columns: one simulator each, the reference first; engines "
         "show the reference in grey behind them. Rows share the time axis: the body "
         "(tilt and heights exaggerated by the factor written on the ground, which grows as "
         "the motion dies down; red dots: touching contacts, yellow: the latest impact), "
         "log10 α, the heading ψ of the lowest point (turns), log10 of the energy "
-        "above rest. Impact raster: a lane per simulator, contact index inside the lane, "
-        "marker size growing with log impulse, red × at the first mismatch. Right: "
+        "above rest, the impacts (y = contact index, marker size growing with log impulse, the "
+        "reference's faint behind an engine's, red × at the first mismatch). Right: "
         "E − E_rest and α against t_f − t on log scales; c only for runs that reach the "
-        "singularity (fit window: the two light lines). v2 = vertex 2, b2 = bump 2.",
-    ]
-    return "\n".join(lines)
+        "singularity (fit window: the two light lines). v2 = vertex 2, b2 = bump 2. The "
+        "rows open on the time from just before the first impact: scroll or drag to zoom, "
+        "double-click to return to it."
+    )

@@ -10,7 +10,8 @@ Inputs (any number, in the order given):
 
 The kind of a document is recognised from its fields (`detect_kind`).  Each gets a
 section: its tables, its verdicts, its figures and its provenance (the command that made
-it, when, on what machine, with every version: harness.provenance).
+it, when, on what machine: harness.provenance); the versions once, in a table at the end
+(a section lists only the versions that differ from it).
 
 How the report finds the plots: it does not.  Every figure is redrawn from the data in
 the document (work-precision from the bench rows, α* and matched fractions from the
@@ -35,9 +36,11 @@ from .sections import (
     compare_section,
     fidelity_section,
     provenance_section,
+    shared_versions,
     stress_section,
     sweep_command,
     sweep_section,
+    versions_table,
 )
 
 KINDS = ("compare", "bench", "fidelity", "stress", "sweep", "restitution")
@@ -127,8 +130,9 @@ def _title(item: ReportInput) -> str:
     return f"{item.kind}: {what}" if what else item.kind
 
 
-def section(item: ReportInput, out_dir: Path) -> str:
-    """The HTML section of one input: its kind's tables and figures, then provenance."""
+def section(item: ReportInput, out_dir: Path, versions: dict[str, str] | None = None) -> str:
+    """The HTML section of one input: its kind's tables and figures, then provenance
+    (versions only where they differ from the report's table, `versions`)."""
     doc = item.doc
     if item.kind == "compare":
         body = compare_section(doc, out_dir)
@@ -145,7 +149,7 @@ def section(item: ReportInput, out_dir: Path) -> str:
     return (
         f"<section><h2>{esc(_title(item))}</h2>"
         f"<p class=muted>from <code>{esc(item.path)}</code></p>\n{body}\n"
-        f"{provenance_section(doc, item.rebuilt_command)}</section>"
+        f"{provenance_section(doc, item.rebuilt_command, versions)}</section>"
     )
 
 
@@ -154,7 +158,9 @@ def build_report(items: list[ReportInput], out_path: str | Path, own: dict[str, 
     out_dir = Path(out_path).resolve().parent
     contents = "".join(f"<li>{esc(_title(i))} <code>{esc(i.path)}</code></li>" for i in items)
     body = [f"<p>Results in this report:</p><ul>{contents}</ul>"]
-    body += [section(i, out_dir) for i in items]
+    versions = shared_versions([i.doc for i in items]) or dict(own.get("versions", {}))
+    body += [section(i, out_dir, versions) for i in items]
+    body.append("<section><h2>Versions</h2>" + versions_table(versions) + "</section>")
     body.append(
         details(
             "how this report was made",

@@ -24,6 +24,8 @@ th, td { border: 1px solid #ccc; padding: .25em .5em; text-align: right; vertica
          white-space: nowrap; }
 th { background: #f0f0f0; }
 td.l, th.l { text-align: left; }
+th.v { writing-mode: vertical-rl; transform: rotate(180deg); white-space: nowrap;
+       padding: .4em .15em; font-weight: normal; }
 td.pass { background: #d9f2d9; } td.fail { background: #f7d4d4; }
 td.skip { background: #eee; color: #777; } td.na { color: #999; }
 div.wide { overflow-x: auto; }  /* a wide table scrolls, the page does not */
@@ -58,15 +60,22 @@ def table(
     rows: Sequence[Sequence[Any]],
     caption: str = "",
     left: int = 1,
+    vertical_from: int | None = None,
 ) -> str:
     """An HTML table; the first `left` columns are left-aligned (names), the rest right
-    (numbers).  Cells are plain values (escaped text) or `Cell`s."""
+    (numbers).  Cells are plain values (escaped text) or `Cell`s.  Header cells from
+    column `vertical_from` on are written vertically (a ladder of many narrow columns
+    then fits the page)."""
     out = ['<div class="wide"><table>']
     if caption:
         out.append(f"<caption>{esc(caption)}</caption>")
-    ths = "".join(
-        f"<th{' class=l' if i < left else ''}>{esc(h)}</th>" for i, h in enumerate(header)
-    )
+
+    def th_class(i: int) -> str:
+        if i < left:
+            return " class=l"
+        return " class=v" if vertical_from is not None and i >= vertical_from else ""
+
+    ths = "".join(f"<th{th_class(i)}>{esc(h)}</th>" for i, h in enumerate(header))
     out.append(f"<thead><tr>{ths}</tr></thead><tbody>")
     for row in rows:
         tds = []

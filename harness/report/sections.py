@@ -13,8 +13,13 @@ from .html import Cell, details, esc, figure, num, paragraph, table
 # ----------------------------------------------------------------------------- provenance
 
 
-def provenance_section(doc: dict[str, Any], rebuilt_command: str | None = None) -> str:
-    """The command that made the document, when, where, and every version."""
+def provenance_section(
+    doc: dict[str, Any],
+    rebuilt_command: str | None = None,
+    shared_versions: dict[str, str] | None = None,
+) -> str:
+    """The command that made the document, when and where; its versions only where they
+    differ from `shared_versions` (the report's one versions table, `versions_table`)."""
     prov = doc.get("provenance")
     if not prov:
         text = "<h3>Provenance</h3>"
@@ -27,13 +32,34 @@ def provenance_section(doc: dict[str, Any], rebuilt_command: str | None = None) 
             "Not recorded: this document was made before results carried a provenance object.",
             "muted",
         )
-    versions = [[k, v] for k, v in sorted(prov.get("versions", {}).items())]
+    own = prov.get("versions", {})
+    differ = [[k, v] for k, v in sorted(own.items()) if (shared_versions or {}).get(k) != v]
+    if not differ:
+        versions = paragraph("Versions: as in the table at the end of the report.", "muted")
+    else:
+        caption = "versions that differ from the table at the end of the report"
+        versions = table(["package", "version"], differ, caption, left=2)
     return (
         "<h3>Provenance</h3>"
         f"<p>Command:</p><pre>{esc(prov.get('command', '-'))}</pre>"
         f"<p>Created {esc(prov.get('created', '-'))} on {esc(prov.get('host', '-'))}.</p>"
-        + table(["package", "version"], versions, "versions (importlib.metadata)", left=2)
+        + versions
     )
+
+
+def shared_versions(docs: list[dict[str, Any]]) -> dict[str, str]:
+    """The versions of the first document that records them (the report's table)."""
+    for doc in docs:
+        versions = (doc.get("provenance") or {}).get("versions")
+        if versions:
+            return dict(versions)
+    return {}
+
+
+def versions_table(versions: dict[str, str]) -> str:
+    """The one versions table of the report (importlib.metadata)."""
+    rows = [[k, v] for k, v in sorted(versions.items())]
+    return table(["package", "version"], rows, "versions (importlib.metadata)", left=2)
 
 
 # ----------------------------------------------------------------------------- compare
@@ -148,6 +174,7 @@ def recording_link(path: str | None, out_dir: Path) -> str:
 
 def bench_section(doc: dict[str, Any]) -> str:
     from ..bench import work_precision_figure
+    from ..bench.table import matched_text
 
     tr = doc["truth"]
     parts = [
@@ -164,7 +191,7 @@ def bench_section(doc: dict[str, Any]) -> str:
             r["setting"],
             r["status"],
             num(r["wall_time_s"], ".3g"),
-            f"{r['impacts_matched']}/{r['reference_impacts']}",
+            matched_text(r),
             num(r["impact_time_error"], ".2e"),
             num(r["energy_error"], ".2e"),
             num(r["energy_error_agreeing"], ".2e"),
@@ -181,7 +208,9 @@ def bench_section(doc: dict[str, Any]) -> str:
         "E err",
         "E err<div",
     ]
-    parts.append(table(header, rows, "work-precision rows", left=2))
+    caption = "work-precision rows (matched k/N*: the run does not follow the reference, fewer "
+    caption += "than 9 of its first 10 impacts matched, and is left out of the summary)"
+    parts.append(table(header, rows, caption, left=2))
     for s in doc.get("skipped", []):
         parts.append(paragraph(f"skipped: {s['engine']} {s['setting']}: {s['reason']}", "muted"))
     derived = doc.get("derived", {}).get("energy_error_agreeing", {})
@@ -201,8 +230,8 @@ def bench_section(doc: dict[str, Any]) -> str:
             table(
                 ["engine", "error at reference cost", "bound", "best error", "cost ratio", "bound"],
                 drows,
-                "energy error before divergence: at the reference's cost, and cost at equal "
-                "accuracy over the reference's",
+                "energy error before divergence, runs that follow the reference: at the "
+                "reference's cost, and cost at equal accuracy over the reference's",
             )
         )
     parts.append(
@@ -328,13 +357,14 @@ def _ladder_table(doc: dict[str, Any], ladder_cell) -> str:
             cls = cls or ("pass" if r["passes"] else "fail")
             cells.append(Cell(ladder_cell(r), cls, r["skipped"] or r.get("first_mismatch") or ""))
         rows.append([engine, num(dt, ".0e"), *cells])
-    header = ["engine", "dt", *[f"{alphas[e]:.1e}" for e in doc["eps"]]]
+    header = ["engine", "dt", *[f"α {alphas[e]:.1e}" for e in doc["eps"]]]
     return table(
         header,
         rows,
         f"leading impacts matched (of {doc['criteria']['leading']}) at each α: green passes, "
         "red fails ('x'), grey skipped for the budget ('s')",
         left=2,
+        vertical_from=2,
     )
 
 

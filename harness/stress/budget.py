@@ -82,8 +82,11 @@ def over_budget(predicted: float, budget: float) -> str:
     return f"predicted {predicted:.3g} s > budget {budget:g} s"
 
 
-def run_capped(fn: Callable[[], Any], cap_s: float) -> tuple[Any, str | None]:
-    """fn() in a forked child process, stopped after cap_s seconds of wall time.
+def run_capped(
+    fn: Callable[[], Any], cap_s: float, tick: Callable[[], None] | None = None
+) -> tuple[Any, str | None]:
+    """fn() in a forked child process, stopped after cap_s seconds of wall time; `tick()`
+    is called about every TICK_S while it runs (a progress line).
 
     Returns (result, None) when it answered, (None, None) when it was stopped at the
     cap (the child, and only it, is terminated by its pid), and (None, message) when
@@ -100,7 +103,7 @@ def run_capped(fn: Callable[[], Any], cap_s: float) -> tuple[Any, str | None]:
     proc.start()
     send.close()
     try:
-        if recv.poll(cap_s):
+        if _wait(recv, cap_s, tick):
             try:
                 out = recv.recv()
             except EOFError:
@@ -116,3 +119,19 @@ def run_capped(fn: Callable[[], Any], cap_s: float) -> tuple[Any, str | None]:
         return None, None
     finally:
         recv.close()
+
+
+TICK_S = 1.0
+
+
+def _wait(recv, cap_s: float, tick: Callable[[], None] | None) -> bool:
+    """Whether `recv` has an answer within cap_s, calling tick() every TICK_S."""
+    deadline = time.monotonic() + cap_s
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return recv.poll(0)
+        if recv.poll(min(left, TICK_S)):
+            return True
+        if tick is not None:
+            tick()

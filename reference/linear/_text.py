@@ -32,16 +32,25 @@ columns:
                    below the ground before tau0), beta_in_0_1, held_vertex_released (gamma = 0:
                    the held vertex n-1 is not pushed into the ground)"""
 
-CHATTER_LEGEND = """\
+_CHATTER_OUTPUT = """\
 output:
   eigenvalues of R^-1 U0  the map of the velocities p over one impact at vertex 0 and the
                           rotation to the next vertex, without gravity
   CC                      complete chatter: the dominant eigenvalue is real and positive
   PCC                     partial complete chatter: U0 U1 has only real eigenvalues
   rod (n = 2)             psi = (1 - rho^2)/(1 + rho^2) against the thresholds of complete
-                          chatter without gravity and with gravity
-table (gravity-free self-similar chatter, one row per pair of eigenvalues):
+                          chatter without gravity and with gravity"""
+_CHATTER_FACTORS = """\
   beta_p, beta_q          factors per impact: p_i = beta_p^i R^i p0, q_i = beta_q^i R^i q0
-  c_lin                   energy exponent of E ~ (t_f - t)^c_lin: 2 log beta_p / log(beta_q/beta_p)
+  c_lin                   energy exponent of E ~ (t_f - t)^c_lin:
+                          2 log beta_p / log(beta_q/beta_p)"""
+_CHATTER_TABLE = f"""\
+table (gravity-free self-similar chatter, one row per pair of eigenvalues):
+{_CHATTER_FACTORS}
   feasible                no contact below the ground, the next vertex reached approaching
   spectral radius         largest |eigenvalue| of the reduced map's Jacobian (< 1: stable)"""
+# With the table of pairs, with the one line of beta_p, beta_q, c_lin (the rod), or with
+# neither (no self-similar chatter); `harness analyze chatter --help` shows the first.
+CHATTER_LEGEND = f"{_CHATTER_OUTPUT}\n{_CHATTER_TABLE}"
+CHATTER_LEGEND_NO_TABLE = f"{_CHATTER_OUTPUT}\n{_CHATTER_FACTORS}"
+CHATTER_LEGEND_OUTPUT_ONLY = _CHATTER_OUTPUT

@@ -31,7 +31,12 @@ import math
 import numpy as np
 
 from ..core.tolerances import TINY
-from ._text import CHATTER_LEGEND, table
+from ._text import (
+    CHATTER_LEGEND,
+    CHATTER_LEGEND_NO_TABLE,
+    CHATTER_LEGEND_OUTPUT_ONLY,
+    table,
+)
 from .model import LinearModel
 
 
@@ -219,7 +224,7 @@ def analyze_chatter(n: int, rho: float, gamma: float) -> dict:
 
 def format_chatter(doc: dict) -> str:
     """The eigenvalues, CC/PCC, the rod's thresholds and the self-similar pairs, then
-    CHATTER_LEGEND."""
+    its legend (CHATTER_LEGEND, without the parts describing what is not printed)."""
     lines = [
         f"chatter (no gravity): n = {doc['n']}, rho = {doc['gyration']}, "
         f"gamma = {doc['restitution']}",
@@ -254,5 +259,11 @@ def format_chatter(doc: dict) -> str:
             if cl is not None
             else "c_lin = -"
         )
-    lines += ["", CHATTER_LEGEND]
+    if doc.get("pairs"):
+        legend = CHATTER_LEGEND
+    elif doc["beta_p"] is not None:
+        legend = CHATTER_LEGEND_NO_TABLE
+    else:
+        legend = CHATTER_LEGEND_OUTPUT_ONLY
+    lines += ["", legend]
     return "\n".join(lines)

@@ -229,7 +229,8 @@ def simulate_linear(
     energy_floor: float = 1e-24,
     chatter_tol: float = 1e-7,
 ) -> Trajectory:
-    """Exact event-driven simulation of the paper's linearised model for a scene.
+    """Exact event-driven simulation of the paper's linearised model for a scene (a
+    Scene, a scene file or a built-in name).
 
     Initial state: the scene's [initial] q/p, or read off its full state (rotation
     vector x/y, position z, angular velocity x/y, velocity z).  Samples: every event
@@ -248,8 +249,10 @@ def simulate_linear(
     exponent.extrapolate_time_to_go), t_end, max_impacts.  Chatter sequences are
     completed in closed form (kernel.py); they are listed in stats["accumulations"], not
     as impacts."""
+    from ..scenes import as_scene
     from .exponent_estimates import extrapolate_time_to_go
 
+    scene = as_scene(scene)
     model = LinearModel.from_scene(scene)
     q0, p0 = linear_state(scene)
     t_end = float(scene.run.t_end if t_end is None else t_end)

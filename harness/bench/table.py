@@ -1,0 +1,143 @@
+"""The terminal text of `harness bench`: the table, its legend, skipped settings, the
+summary (derived numbers of the runs that follow the reference), the load.  The default
+fits 100 columns; `wide=True` adds the min time, the attitude errors and the divergence
+time, and prints the summary's sentences whole."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from ..metrics.follows import LEADING_IMPACTS, MATCH_FRACTION
+from ..text import table
+
+WIDTH = 100
+# Status names shortened in the default table (the JSON and --wide keep them whole).
+SHORT_STATUS = {"simultaneous_impact": "simultaneous"}
+
+
+def _fmt(x: float | None, spec: str = ".2e") -> str:
+    return "-" if x is None or not math.isfinite(x) else format(x, spec)
+
+
+def _short(x: float | None) -> str:
+    """1e-06 -> 1e-6 (a setting in the narrow table)."""
+    if x is None:
+        return "-"
+    mantissa, _, exp = f"{x:.0e}".partition("e")
+    return f"{mantissa}e{int(exp)}"
+
+
+def setting_text(row: dict[str, Any], wide: bool) -> str:
+    if wide or (row["dt"] is None and row["contact_rtol"] is None):
+        return row["setting"]
+    if row["dt"] is not None:
+        return f"dt {_short(row['dt'])}"
+    return f"rtol {_short(row['contact_rtol'])} ch {_short(row['chatter_tol'])}"
+
+
+def matched_text(row: dict[str, Any]) -> str:
+    """k/N, marked '*' when the run does not follow the reference."""
+    mark = "" if row.get("follows_reference", True) else "*"
+    return f"{row['impacts_matched']}/{row['reference_impacts']}{mark}"
+
+
+def results_table(doc: dict[str, Any], wide: bool) -> str:
+    header = ["engine", "setting", "status", "time[s]"]
+    header += ["min[s]"] if wide else []
+    header += ["matched", "t_err[s]", "E_err", "E_err<div"]
+    header += ["att<div", "diverges[s]"] if wide else []
+    rows = []
+    for r in doc["results"]:
+        status = r["status"] if wide else SHORT_STATUS.get(r["status"], r["status"])
+        row = [r["engine"], setting_text(r, wide), status, _fmt(r["wall_time_s"], ".3g")]
+        row += [_fmt(r["wall_time_min_s"], ".3g")] if wide else []
+        row += [matched_text(r), _fmt(r["impact_time_error"]), _fmt(r["energy_error"])]
+        row += [_fmt(r["energy_error_agreeing"])]
+        if wide:
+            row += [
+                _fmt(r.get("attitude_error_agreeing")),
+                _fmt(r.get("first_divergence_time"), ".4g"),
+            ]
+        rows.append(row)
+    return table(rows, header, align="lll" + "r" * (len(header) - 3))
+
+
+LEGEND = f"""\
+matched    k/N: the first k of the reference's N impacts the run reproduces in order (same
+           contact, time within the window); N counts the reference's impacts up to the
+           earlier end of the two runs, so a run that fails or stops early has a small N
+           * the run does not follow the reference (fewer than {MATCH_FRACTION:.0%} of its first
+           {LEADING_IMPACTS} impacts matched): left out of the summary below
+t_err      max |t - t_ref| over the matched impacts [s]
+E_err      max |E - E_ref| / E_ref(0) over the common window; E_err<div: up to the divergence
+setting    dt: fixed timestep [s]; rtol R ch C: the reference's contact_rtol and chatter_tol
+time       median wall time of one run [s] (--wide: and the fastest)
+(docs/output.md defines every column; --wide: every column, --json: every number)"""
+
+
+def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
+    """Per metric, each simulator's best error among the runs that follow the
+    reference, its cost, and the cost ratio to the reference at that accuracy."""
+    derived = doc.get("derived", {})
+    engines = [e for e in dict.fromkeys(r["engine"] for r in doc["results"]) if e != "reference"]
+    lines = [
+        "summary (runs that follow the reference only): best error, its cost, and that cost "
+        "over the",
+        "reference's cost at the same accuracy ('>=': a lower bound, '<=': an upper bound)",
+    ]
+    for metric, per in derived.items():
+        rows = []
+        for engine in engines:
+            d = per.get(engine)
+            if d is None:
+                rows.append([engine, "-", "-", "no run follows the reference"])
+                continue
+            bound = {"lower": ">=", "upper": "<="}.get(d["cost_ratio_bound"], "")
+            ratio = _fmt(d["cost_ratio"], ".3g")
+            rows.append(
+                [engine, _fmt(d["best_error"]), f"{d['best_error_cost_s']:.3g}", f"{bound}{ratio}x"]
+            )
+        lines += [
+            "",
+            f"{metric}:",
+            table(rows, ["simulator", "best", "cost[s]", "x reference"], align="lrrl"),
+        ]
+    return lines
+
+
+def format_bench(doc: dict[str, Any], wide: bool = False) -> str:
+    """The work-precision table with its legend, skipped settings, the summary and the
+    load (module docstring)."""
+    tr = doc["truth"]
+    lines = [
+        f"scene {doc['scene']}: t = 0 .. {doc['t_end']:.6g}; truth: the reference at "
+        f"{tr['setting']}",
+        f"({tr['status']}, {tr['impacts']} impacts)",
+        "",
+        results_table(doc, wide),
+        "",
+        LEGEND,
+    ]
+    skipped = doc.get("skipped", [])
+    if skipped:
+        lines.append("")
+    for s in skipped:
+        lines.append(_clip(f"skipped: {s['engine']} {s['setting']}: {s['reason']}", wide))
+    lines += ["", *summary_lines(doc, wide), ""]
+    load = doc["load"]
+    lines.append(
+        f"load average (1, 5, 15 min) before {_triple(load['before'])}, after "
+        f"{_triple(load['after'])}; {doc['cpu_count']} cpus"
+    )
+    lines.append(f"times: median of {doc['repeats']} runs after a warm-up")
+    return "\n".join(lines)
+
+
+def _clip(line: str, wide: bool) -> str:
+    return line if wide or len(line) <= WIDTH else line[: WIDTH - 3] + "..."
+
+
+def _triple(x: Sequence[float]) -> str:
+    return " ".join(f"{v:.2f}" for v in x)
