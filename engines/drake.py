@@ -532,7 +532,7 @@ def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None
         "max_step": settings.max_step,
         "accuracy": settings.accuracy,
         "restitution_model": settings.restitution_model,
-        "quaternion_norm_drift": quaternion_norm_drift(np.array(rows)),
+        "quaternion_norm_drift": quaternion_norm_drift(np.array(stepper.rows)),
         "drake_version": _drake_version(),
     }
     if loop.interrupted:

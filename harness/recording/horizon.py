@@ -1,9 +1,9 @@
 """The horizon band in each engine's impact raster (raster.py): where
 the exact model with its impacts on that run's step grid stops matching the reference
 (harness.horizon, level (a): the 10 % … 90 % matched counts), drawn as a thick bar in
-the raster's blank row above its contacts (y = n_contacts), from the time of the reference's impact at the
-10 % count to that at the 90 % count.  A run whose red × (first mismatch) lies left of
-its bar diverged before its timestep forces it to.
+the raster's blank row above its contacts (y = n_contacts), from the time of the
+reference's impact at the 10 % count to that at the 90 % count.  A run whose red ×
+(first mismatch) lies left of its bar diverged before its timestep forces it to.
 
     /impacts/<sim>/horizon_band     SeriesLines, two points (band start, band end)
 """
