@@ -36,6 +36,8 @@ alone when g = 0), with the velocity unit U = a/τ = max(√(g a), a/t_end):
 from __future__ import annotations
 
 import math
+import os
+import stat
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -183,10 +185,13 @@ def load_scene(path: str | Path) -> Scene:
     try:
         if not path.exists():
             raise SceneError(f"scene file not found: {shown}")
-        if not path.is_file():
-            raise SceneError(f"{shown} is not a regular file (a scene is a TOML file)")
+        problem = input_file_problem(path)
+        if problem:
+            raise SceneError(f"{shown}: {problem} (a scene is a TOML file)")
         with open(path, "rb") as fh:
             raw = fh.read(MAX_SCENE_FILE_BYTES + 1)
+    except SceneError:
+        raise
     except OSError as exc:
         raise SceneError(f"cannot read scene file {shown}: {exc.strerror or exc}") from None
     except ValueError as exc:  # e.g. a NUL character in the path
@@ -194,7 +199,7 @@ def load_scene(path: str | Path) -> Scene:
     if len(raw) > MAX_SCENE_FILE_BYTES:
         raise SceneError(f"{shown} is larger than {MAX_SCENE_FILE_BYTES} bytes: not a scene file")
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        data = tomllib.loads(raw.decode("utf-8-sig"))  # a byte-order mark is accepted
     except UnicodeDecodeError:
         raise SceneError(f"{shown} is not UTF-8 text (scene files are TOML)") from None
     except tomllib.TOMLDecodeError as exc:
@@ -202,6 +207,28 @@ def load_scene(path: str | Path) -> Scene:
     except RecursionError:
         raise SceneError(f"{shown}: TOML nested too deeply to be a scene") from None
     return scene_from_dict(data, default_name=path.stem)
+
+
+def input_file_problem(path: str | Path) -> str:
+    """Why `path` cannot be read as an input file ('' for a regular file, or a link to
+    one): missing, or which kind of non-regular file it is (a FIFO would block the read)."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "no such file or directory"
+    except (OSError, ValueError) as exc:
+        return f"cannot be read ({getattr(exc, 'strerror', None) or exc})"
+    for test, what in (
+        (stat.S_ISREG, ""),
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    ):
+        if test(mode):
+            return f"{what}, not a regular file" if what else ""
+    return "not a regular file"
 
 
 def show_path(path: str | Path, limit: int = 80) -> str:

@@ -20,6 +20,7 @@ import traceback
 from reference.scene import SceneError
 
 from ..outputs import OutputError
+from ..text import terminal_safe
 from . import (
     analyze,
     bench,
@@ -96,7 +97,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def one_line(text: str) -> str:
     """A message as one line (a TOML error may quote the offending line)."""
-    return " ".join(text.split())
+    return terminal_safe(" ".join(text.split()))
 
 
 if __name__ == "__main__":
