@@ -104,7 +104,8 @@ def test_a_bom_json_is_read_and_a_fifo_is_named(tmp_path, capsys, compare_doc):
 def test_a_bom_scene_is_accepted_and_a_fifo_scene_named(tmp_path, capsys):
     scene = tmp_path / "s.toml"
     scene.write_bytes(
-        b"\xef\xbb\xbf" + b'name = "bom"\n[body]\nn = 3\n[initial]\nq = [0.01, 0, 1]\np = [0, 0, -0.1]\n'
+        b"\xef\xbb\xbf"
+        + b'name = "bom"\n[body]\nn = 3\n[initial]\nq = [0.01, 0, 1]\np = [0, 0, -0.1]\n'
     )
     assert main(["simulate", str(scene), "--t-end", "0.01"]) == 0
     assert "bom" in capsys.readouterr().out
