@@ -21,6 +21,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import metadata
 
+from reference.checks import run_horizon
 from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
@@ -187,8 +188,9 @@ def check_run(
     simulate = load_engine(engine)
     if dt is not None and not (math.isfinite(dt) and dt > 0):
         raise SceneError(f"--dt must be > 0, got {dt}")
-    if t_end is not None:
-        scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
+    # t_end (or the scene's own) in range, with the speed group, like [run]: the one
+    # check the Python API makes too (reference.checks)
+    scene = scene.with_run(t_end=run_horizon(scene, t_end))
     limit = getattr(simulate, "max_vertices", None)
     if limit is not None and scene.body.n > limit:
         raise SceneError(

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import compiled
+from .checks import check_reference_options, run_horizon
 from .core import records as R
 from .core.records import (
     N_ACCUMULATIONS,
@@ -210,9 +211,10 @@ def simulate(
     `progress(t)` is called with the time reached whenever the loop returns to Python
     (every `options.work_budget` steps).  stats.wall_time_s is the run alone;
     stats.compile_s the one-time compilation or loading that preceded it."""
-    opts = options or ReferenceOptions()
+    opts = ReferenceOptions() if options is None else options
+    t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
+    check_reference_options(opts)
     compile_s = compiled.warm_up()
-    t_end = float(t_end if t_end is not None else scene.run.t_end)
     problem = make_problem(scene, t_end, opts)
     kernel = compiled.run_events()
     t0 = time.perf_counter()

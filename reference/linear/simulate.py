@@ -18,6 +18,7 @@ import numpy as np
 
 from ..trajectory import ImpactEvent, Phase, Status, Trajectory
 from . import kernel as K
+from .domain import cut_at_exit, first_exit
 from .model import LinearModel, full_states, linear_state
 
 STATUS = {
@@ -242,17 +243,20 @@ def simulate_linear(
     reference.geometry.energies of the mapped full state by ½ (I3 − I1)(ω·e3)²
     with ω·e3 = ωx φy − ωy φx, i.e. by O(α²) relative.
 
-    Status as the reference: simultaneous_impact when undecidable, singularity when all
-    contacts are down (t_singularity exact) or the energy fell below `energy_floor` of
-    its initial value (t_singularity extrapolated from the last energy decades, see
-    exponent.extrapolate_time_to_go), t_end, max_impacts.  Chatter sequences are
-    completed in closed form (kernel.py); they are listed in stats["accumulations"], not
-    as impacts."""
+    Status as the reference: left_model once the tilt leaves the model's small-tilt
+    domain (domain.TILT_LIMIT; the run is cut there), simultaneous_impact when
+    undecidable, singularity when all contacts are down (t_singularity exact) or the
+    energy fell below `energy_floor` of its initial value (t_singularity extrapolated
+    from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
+    max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
+    listed in stats["accumulations"], not as impacts."""
+    from ..checks import check_linear_options, run_horizon
     from .exponent import extrapolate_time_to_go
 
+    t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
+    check_linear_options(sample_dt, energy_floor, chatter_tol)
     model = LinearModel.from_scene(scene)
     q0, p0 = linear_state(scene)
-    t_end = float(scene.run.t_end if t_end is None else t_end)
     run = run_linear(
         model,
         q0,
@@ -262,6 +266,9 @@ def simulate_linear(
         energy_floor=energy_floor,
         chatter_tol=chatter_tol,
     )
+    exit_at = first_exit(run)
+    if exit_at is not None:  # beyond the small tilts the model holds for (domain.py)
+        run = cut_at_exit(run, *exit_at)
     t_sing = None
     t_final = run.t_final
     if run.status is Status.SINGULARITY:
