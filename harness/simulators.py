@@ -190,7 +190,9 @@ def check_run(
         raise SceneError(f"--dt must be > 0, got {dt}")
     # t_end (or the scene's own) in range, with the speed group, like [run]: the one
     # check the Python API makes too (reference.checks)
-    scene = scene.with_run(t_end=run_horizon(scene, t_end))
+    horizon = run_horizon(scene, t_end)
+    if t_end is not None:
+        scene = scene.with_run(t_end=horizon)
     limit = getattr(simulate, "max_vertices", None)
     if limit is not None and scene.body.n > limit:
         raise SceneError(

@@ -16,7 +16,7 @@ import math
 from numbers import Integral, Real
 from typing import Any
 
-from .scene import Scene, SceneError
+from .scene import Scene, SceneError, check_t_end
 
 # Largest samples and loop steps between returns to Python a run may be given.
 MAX_SAMPLES = 100_000_000
@@ -24,14 +24,19 @@ MAX_WORK_BUDGET = 1_000_000_000
 
 
 def run_horizon(scene: Any, t_end: Any = None) -> float:
-    """The run's end time (t_end, else the scene's own), checked with the scene: SceneError
-    unless `scene` is a Scene and t_end a number in the range of a scene file's t_end."""
+    """The run's end time: SceneError unless `scene` is a Scene and the end time (t_end,
+    else the scene's own) a number in the range of a scene file's t_end
+    (`reference.scene.check_t_end`); a t_end given here is checked with the scene too
+    (`Scene.with_run`: the speed group it implies), as the command line's --t-end."""
     if not isinstance(scene, Scene):
         raise SceneError(f"a Scene is needed (reference.scene), got {type(scene).__name__}")
     value = scene.run.t_end if t_end is None else t_end
     if isinstance(value, bool) or not isinstance(value, Real):
         raise SceneError(f"t_end must be a number, got {type(value).__name__}")
-    return float(scene.with_run(t_end=float(value)).run.t_end)
+    check_t_end(float(value))
+    if t_end is not None:
+        scene.with_run(t_end=float(value))
+    return float(value)
 
 
 def check_reference_options(opts: Any) -> None:

@@ -127,7 +127,7 @@ class Scene:
         """The scene with other run settings, checked like a scene file's [run]
         (a longer t_end lowers the velocity unit U of the speed check)."""
         if "t_end" in changes:
-            _check_in_range("t_end", changes["t_end"], DIMENSION_RANGE)
+            check_t_end(changes["t_end"])
         if "max_impacts" in changes:
             _check_max_impacts(changes["max_impacts"])
         scene = replace(self, run=replace(self.run, **changes))
@@ -449,6 +449,11 @@ def _check_in_range(name: str, x: Any, bounds: tuple[float, float], zero_ok=Fals
     if isinstance(x, bool) or not isinstance(x, (int, float)) or not lo <= x <= hi:
         zero = "0 or " if zero_ok else ""
         raise SceneError(f"{name} must be {zero}in [{lo:g}, {hi:g}], got {x!r}")
+
+
+def check_t_end(x: Any) -> None:
+    """A run's end time: a number in DIMENSION_RANGE (NaN, 0, negative, inf refused)."""
+    _check_in_range("t_end", x, DIMENSION_RANGE)
 
 
 def _check_max_impacts(mi: Any) -> None:

@@ -149,3 +149,44 @@ def test_a_sweep_whose_folder_turns_unwritable_mid_run_ends_with_one_line(tmp_pa
         sweep(tmp_path)
     parts = sorted((tmp_path / "linear" / "parts").iterdir())
     assert [p.name.startswith("part-") for p in parts] == [True, True]
+
+
+def test_sigterm_mid_sweep_exits_143_and_leaves_no_temporary(tmp_path):
+    import signal
+    import sys
+
+    out = tmp_path / "sweep"
+    argv = ["sweep", "exponent", "--gyration", "0.3:0.5:5", "--restitution", "0.3:0.6:5"]
+    argv += ["--samples", "400", "--engine", "linear", "--workers", "1", "--out", str(out)]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "harness", *argv],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    parts = out / "linear" / "parts"
+    deadline = time.monotonic() + 120
+    while not (parts.is_dir() and any(parts.glob("part-*"))) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert err.strip().splitlines()[-1] == "harness: terminated"
+    assert not [p for p in out.rglob(f"{TEMP_PREFIX}*")]
+
+
+def test_a_sweep_removes_the_temporaries_a_killed_sweep_left(tmp_path):
+    from tests.test_sweep_heal import sweep
+
+    sweep(tmp_path)
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    left = [
+        tmp_path / f"{TEMP_PREFIX}{dead.pid}-compare.png",
+        tmp_path / "linear" / f"{TEMP_PREFIX}{dead.pid}-map.png",
+        tmp_path / "linear" / "parts" / f"{TEMP_PREFIX}{dead.pid}-part.parquet",
+    ]
+    for p in left:
+        p.write_bytes(b"")
+    sweep(tmp_path)
+    assert not [p for p in tmp_path.rglob(f"{TEMP_PREFIX}*")]

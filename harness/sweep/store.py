@@ -177,7 +177,8 @@ class SweepStore:
     def _open_locked(self) -> None:
         for tmp in self.parts_dir.glob(".tmp-*"):  # temporaries of earlier versions
             tmp.unlink(missing_ok=True)
-        remove_stale_temporaries(self.parts_dir)
+        for folder in (self.root, self.dir, self.parts_dir):  # a run killed mid-write
+            remove_stale_temporaries(folder)
         self.notes: list[str] = []
         self._check_manifest()
         table, refused = verify_parts(self.parts_dir, self.config)
