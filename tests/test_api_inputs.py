@@ -79,3 +79,32 @@ def test_unusable_linear_options_are_refused(scene, options, field):
 def test_a_scene_that_is_no_scene_is_refused():
     with pytest.raises(SceneError, match="a Scene is needed"):
         reference.simulate({"body": {"n": 3}}, t_end=1.0)
+
+
+def test_the_linear_loop_returns_to_python_every_budget_of_events(scene, monkeypatch):
+    """Ctrl-C is seen between calls of the compiled loop: with a budget of 10 passes the
+    run takes one call per 10 events, and its events are those of one long call."""
+    import numpy as np
+
+    import reference.linear.simulate as ls
+    from reference.linear import kernel as K
+    from reference.linear.model import LinearModel, linear_state
+
+    model = LinearModel.from_scene(scene)
+    q0, p0 = linear_state(scene)
+    whole = ls.run_linear(model, q0, p0, t_end=3.0)
+    calls = []
+    real = K.continue_kernel
+
+    def counted(*args):
+        calls.append(args[-1])
+        return real(*args)
+
+    monkeypatch.setattr(ls, "LOOP_BUDGET", 10)
+    monkeypatch.setattr(K, "continue_kernel", counted)
+    sliced = ls.run_linear(model, q0, p0, t_end=3.0)
+    assert len(whole.kind) > 50 and len(calls) >= len(whole.kind) // 10
+    assert set(calls) == {10}
+    np.testing.assert_array_equal(sliced.t_hi, whole.t_hi)
+    np.testing.assert_array_equal(sliced.q_post, whole.q_post)
+    assert sliced.status is whole.status and sliced.message == whole.message

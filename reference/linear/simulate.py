@@ -21,6 +21,10 @@ from . import kernel as K
 from .domain import cut_at_exit, first_exit
 from .model import LinearModel, full_states, linear_state
 
+# Passes of the linear event loop per call of the compiled kernel: Python regains control
+# (Ctrl-C) every few tens of milliseconds (one pass is ~0.1-3 µs).
+LOOP_BUDGET = 50_000
+
 STATUS = {
     K.T_END: Status.T_END,
     K.SINGULARITY: Status.SINGULARITY,
@@ -139,27 +143,23 @@ def run_linear(
     out_f = np.empty((cap, K.N_FCOLS))
     out_s = np.zeros((cap if record_states else 1, K.N_SCOLS))
     info = np.zeros(K.N_INFO, dtype=np.int64)
+    tinv = 1.0 / model.theta
+    w, wmax = K._contact_products(F, tinv)
+    consts = (F, model.theta, tinv, w, wmax, model.mass)
+    loop = K.new_loop_state(F.shape[0])
     t0 = time.perf_counter()
-    n = K.simulate_kernel(
-        F,
-        model.theta,
-        model.mass,
-        model.gravity,
-        model.restitution,
-        model.rank,
-        q0,
-        p0,
-        float(t_end),
-        int(max_impacts),
-        float(log2_floor),
-        float(chatter_tol),
-        float(decouple_tol),
-        bool(record_states),
-        out_i,
-        out_f,
-        out_s,
-        info,
-    )
+    done = K.start_kernel(
+        *consts, model.gravity, model.restitution, model.rank, q0, p0, bool(record_states),
+        out_i, out_f, out_s, info, *loop[:9],
+    )  # fmt: skip
+    while not done:  # back in Python every LOOP_BUDGET events: Ctrl-C works
+        n = K.continue_kernel(
+            *consts, model.restitution, model.rank, float(t_end), int(max_impacts),
+            float(log2_floor), float(chatter_tol), float(decouple_tol), bool(record_states),
+            out_i, out_f, out_s, info, *loop, LOOP_BUDGET,
+        )  # fmt: skip
+        done = n >= 0
+    n = int(loop[7][K.SI_EVENTS])
     wall = time.perf_counter() - t0
     status = STATUS[int(info[0])]
     reason = int(info[5])
