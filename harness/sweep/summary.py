@@ -109,7 +109,7 @@ def format_summary(doc: dict) -> str:
                 cells.append(f"{m:6.2f}" if m is not None else "     -")
             lines.append(f"  {r:6.3f} " + "".join(cells))
     lines.append("")
-    lines += [f"set aside: {note}" for note in doc.get("set_aside", [])]
+    lines += doc.get("set_aside", [])  # "set aside <kind> part <name>: <why>"
     lines.append(f"parts: {doc['parts']['dir']} ({doc['parts']['count']} files)")
     for name, path in doc["figures"].items():
         lines.append(f"{name}: {path}")
