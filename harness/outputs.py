@@ -14,7 +14,13 @@ destroy"):
   move it into place only when the writer finished (os.link without --force, so that a
   file that appeared meanwhile is still not replaced; os.replace with it).  A run that
   fails or is interrupted leaves neither a half-written file nor a temporary one, nor
-  folders it created for nothing.
+  folders it created for nothing.  Before the move each file is flushed to disk
+  (fsync) and its size checked against what was written, so a full disk (ENOSPC at
+  write, close or fsync) or a lost permission ends in `OutputError` naming the path and
+  the cause, never in a short file under the final name.
+- Temporary names carry the writer's process id (`.harness-tmp-<pid>-…`): the next
+  write into a folder removes those of processes no longer running (a run killed with
+  SIGKILL cannot clean up after itself), `remove_stale_temporaries`.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import errno
 import os
 import stat
 import tempfile
+import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
@@ -32,6 +39,8 @@ from reference.scene import show_path as show
 TEMP_PREFIX = ".harness-tmp-"
 # A path component longer than this (bytes) is refused where os.pathconf cannot tell.
 DEFAULT_NAME_MAX = 255
+# A temporary name whose writer cannot be told (no process id in it) is stale after this.
+STALE_AFTER_S = 3600.0
 
 
 class OutputError(Exception):
@@ -109,20 +118,21 @@ def atomic_outputs(paths: Sequence[str | os.PathLike], force: bool = False) -> I
     try:
         for target in targets:
             created += _make_folders(target.parent)
+            remove_stale_temporaries(target.parent)
             fd, name = tempfile.mkstemp(
-                dir=target.parent, prefix=TEMP_PREFIX, suffix=target.suffix or None
+                dir=target.parent, prefix=temp_prefix(), suffix=target.suffix or None
             )
             tmps.append(Path(name))
             os.fchmod(fd, _mode_for(target))  # mkstemp makes it private (0600)
             os.close(fd)
         yield list(tmps)
+        for tmp in tmps:
+            _sync(tmp)
         for tmp, target in zip(tmps, targets, strict=True):
             _commit(tmp, target, force)
     except OSError as exc:
         _discard(tmps, created)
-        raise OutputError(
-            f"cannot write {show(exc.filename or targets[0])}: {_reason(exc)}"
-        ) from None
+        raise OutputError(cannot_write(_failed_target(exc, tmps, targets), exc)) from None
     except BaseException:
         _discard(tmps, created)
         raise
@@ -138,9 +148,84 @@ def atomic_write(path: str | os.PathLike, force: bool = False) -> Iterator[Path]
 
 
 def write_text(path: str | os.PathLike, text: str, force: bool = False) -> Path:
+    return write_bytes(path, text.encode("utf-8"), force)
+
+
+def write_bytes(path: str | os.PathLike, data: bytes, force: bool = False) -> Path:
+    """`data` under `path`, atomically; read back (size and tail) before the move."""
     with atomic_write(path, force) as tmp:
-        tmp.write_text(text)
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+        _check_contents(tmp, data)
     return Path(path)
+
+
+def temp_prefix() -> str:
+    """`.harness-tmp-<pid>-`: whose temporary file this is (`remove_stale_temporaries`)."""
+    return f"{TEMP_PREFIX}{os.getpid()}-"
+
+
+def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files a killed run left in `folder`: those whose process id
+    names no running process, and those without one older than STALE_AFTER_S.  Returns
+    what was removed; a file that cannot be removed is left alone."""
+    removed = []
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(folder):
+            if entry.name.startswith(TEMP_PREFIX) and entry.is_file(follow_symlinks=False):
+                if _is_stale(entry) and _unlink(entry.path):
+                    removed.append(Path(entry.path))
+    return removed
+
+
+def _is_stale(entry: os.DirEntry) -> bool:
+    pid_text = entry.name[len(TEMP_PREFIX) :].split("-", 1)[0]
+    if pid_text.isdigit():
+        return not _process_alive(int(pid_text))
+    try:
+        return time.time() - entry.stat(follow_symlinks=False).st_mtime > STALE_AFTER_S
+    except OSError:
+        return False
+
+
+def _process_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True  # exists, owned by someone else (or not a pid: leave it)
+    return True
+
+
+def _unlink(path: str) -> bool:
+    try:
+        os.unlink(path)
+    except OSError:
+        return False
+    return True
+
+
+def _sync(tmp: Path) -> None:
+    """Flush a finished temporary file to disk: a full disk may only say so here."""
+    fd = os.open(tmp, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _check_contents(tmp: Path, data: bytes) -> None:
+    """The file holds `data`: its size, and its last bytes read back."""
+    size = os.stat(tmp).st_size
+    tail = data[-4096:]
+    with open(tmp, "rb") as fh:
+        fh.seek(max(size - len(tail), 0))
+        back = fh.read()
+    if size != len(data) or back != tail:
+        raise OSError(errno.EIO, f"read back {size} bytes of {len(data)} written", str(tmp))
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -260,5 +345,27 @@ def _discard(tmps: list[Path], created: list[Path]) -> None:
             folder.rmdir()  # only if still empty
 
 
+def _failed_target(exc: OSError, tmps: list[Path], targets: list[Path]) -> Path:
+    """The output a failure concerns: the target of a temporary file or of a folder
+    named in the error, else the first."""
+    failed = str(exc.filename)
+    for tmp, target in zip(tmps, targets, strict=False):
+        if failed == str(tmp):
+            return target
+    for target in targets:
+        if failed in (str(target), str(target.parent), os.path.abspath(target.parent)):
+            return target
+    return targets[0]
+
+
+def cannot_write(path, exc: OSError) -> str:
+    """'cannot write PATH: CAUSE', the one line every write failure ends with."""
+    return f"cannot write {show(path)}: {_reason(exc)}"
+
+
 def _reason(exc: OSError) -> str:
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        return "disk full (no space left on device)"
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return "permission denied" if exc.errno != errno.EROFS else "read-only file system"
     return exc.strerror or str(exc)

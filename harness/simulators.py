@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from importlib import metadata
 
 from engines.interface import attribute
+from reference.checks import run_horizon
 from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
@@ -194,8 +195,11 @@ def check_run(
     simulate = load_engine(engine)
     if dt is not None and not (math.isfinite(dt) and dt > 0):
         raise SceneError(f"dt must be > 0, got {dt}")
+    # t_end (or the scene's own) in range, with the speed group, like [run]: the one
+    # check the Python API makes too (reference.checks)
+    horizon = run_horizon(scene, t_end)
     if t_end is not None:
-        scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
+        scene = scene.with_run(t_end=horizon)
     limit = attribute(simulate, "max_vertices")
     if limit is not None and scene.body.n > limit:
         raise SceneError(

@@ -32,6 +32,24 @@ def format_simulate(traj: Trajectory) -> str:
     return "\n".join(lines)
 
 
+# Bidirectional-text overrides and isolates: invisible, but they reorder what follows.
+_BIDI = set(range(0x202A, 0x202F)) | set(range(0x2066, 0x206A))
+
+
+def terminal_safe(text: str) -> str:
+    r"""`text` with every control character escaped (\x1b, \u202e, ...), except the line
+    breaks and tabs of multi-line text: a name read from a file cannot move the cursor,
+    retitle the terminal or reorder a line (the CLI's every text output passes here)."""
+    return "".join(_escaped(ch) for ch in text)
+
+
+def _escaped(ch: str) -> str:
+    code = ord(ch)
+    if ch in "\n\t" or not (code < 32 or 127 <= code < 160 or code in _BIDI):
+        return ch
+    return f"\\x{code:02x}" if code < 256 else f"\\u{code:04x}"
+
+
 def num(x: Any, spec: str = ".3g") -> str:
     """A table cell's text: '-' for None or a non-finite float, yes/no for a bool, ints
     as they are, floats by `spec`, anything else by str()."""

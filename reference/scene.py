@@ -36,6 +36,8 @@ alone when g = 0), with the velocity unit U = a/τ = max(√(g a), a/t_end):
 from __future__ import annotations
 
 import math
+import os
+import stat
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -125,7 +127,7 @@ class Scene:
         """The scene with other run settings, checked like a scene file's [run]
         (a longer t_end lowers the velocity unit U of the speed check)."""
         if "t_end" in changes:
-            _check_in_range("t_end", changes["t_end"], DIMENSION_RANGE)
+            check_t_end(changes["t_end"])
         if "max_impacts" in changes:
             _check_max_impacts(changes["max_impacts"])
         scene = replace(self, run=replace(self.run, **changes))
@@ -195,8 +197,9 @@ def load_scene_file(path: str | Path) -> Scene:
     try:
         if not path.exists():
             raise SceneError(f"scene file not found: {shown}")
-        if not path.is_file():
-            raise SceneError(f"{shown} is not a regular file (a scene is a TOML file)")
+        problem = input_file_problem(path)
+        if problem:
+            raise SceneError(f"{shown}: {problem} (a scene is a TOML file)")
         with open(path, "rb") as fh:
             raw = fh.read(MAX_SCENE_FILE_BYTES + 1)
     except SceneError:
@@ -208,7 +211,7 @@ def load_scene_file(path: str | Path) -> Scene:
     if len(raw) > MAX_SCENE_FILE_BYTES:
         raise SceneError(f"{shown} is larger than {MAX_SCENE_FILE_BYTES} bytes: not a scene file")
     try:
-        data = tomllib.loads(raw.decode("utf-8"))
+        data = tomllib.loads(raw.decode("utf-8-sig"))  # a byte-order mark is accepted
     except UnicodeDecodeError:
         raise SceneError(f"{shown} is not UTF-8 text (scene files are TOML)") from None
     except tomllib.TOMLDecodeError as exc:
@@ -216,6 +219,28 @@ def load_scene_file(path: str | Path) -> Scene:
     except RecursionError:
         raise SceneError(f"{shown}: TOML nested too deeply to be a scene") from None
     return scene_from_dict(data, default_name=path.stem)
+
+
+def input_file_problem(path: str | Path) -> str:
+    """Why `path` cannot be read as an input file ('' for a regular file, or a link to
+    one): missing, or which kind of non-regular file it is (a FIFO would block the read)."""
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "no such file or directory"
+    except (OSError, ValueError) as exc:
+        return f"cannot be read ({getattr(exc, 'strerror', None) or exc})"
+    for test, what in (
+        (stat.S_ISREG, ""),
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+    ):
+        if test(mode):
+            return f"{what}, not a regular file" if what else ""
+    return "not a regular file"
 
 
 def show_path(path: str | Path, limit: int = 80) -> str:
@@ -444,6 +469,11 @@ def _check_in_range(name: str, x: Any, bounds: tuple[float, float], zero_ok=Fals
     if isinstance(x, bool) or not isinstance(x, (int, float)) or not lo <= x <= hi:
         zero = "0 or " if zero_ok else ""
         raise SceneError(f"{name} must be {zero}in [{lo:g}, {hi:g}], got {x!r}")
+
+
+def check_t_end(x: Any) -> None:
+    """A run's end time: a number in DIMENSION_RANGE (NaN, 0, negative, inf refused)."""
+    _check_in_range("t_end", x, DIMENSION_RANGE)
 
 
 def _check_max_impacts(mi: Any) -> None:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import compiled
+from .checks import check_reference_options, run_horizon
 from .core import records as R
 from .core.records import (
     N_ACCUMULATIONS,
@@ -215,9 +216,10 @@ def simulate(
     from .scenes import as_scene
 
     scene = as_scene(scene)
-    opts = options or ReferenceOptions()
+    opts = ReferenceOptions() if options is None else options
+    t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
+    check_reference_options(opts)
     compile_s = load_event_loop()
-    t_end = float(t_end if t_end is not None else scene.run.t_end)
     problem = make_problem(scene, t_end, opts)
     kernel = compiled.run_events()
     t0 = time.perf_counter()

@@ -14,13 +14,17 @@ accepted ranges.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import signal
 import sys
+import threading
 import traceback
 
 from reference.scene import SceneError
 
 from ..outputs import OutputError
 from ..provenance import PACKAGE, PROGRAM, distribution_version
+from ..text import terminal_safe
 from . import (
     analyze,
     bench,
@@ -77,7 +81,34 @@ def _subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser
     return found
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that every cleanup runs (temporary files removed,
+    pools shut down); the command exits 143."""
+
+
+def _terminate(signum, frame) -> None:
+    raise Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_as_interrupt():
+    """SIGTERM raises Terminated while the command runs (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
+    with _sigterm_as_interrupt():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
         args = build_parser().parse_args(argv)
@@ -89,6 +120,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except SystemExit as exc:  # --help, --version: argparse exits
         return exc.code if isinstance(exc.code, int) else 0
+    except Terminated:
+        print("harness: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("harness: interrupted", file=sys.stderr)
         return 130
@@ -102,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def one_line(text: str) -> str:
     """A message as one line (a TOML error may quote the offending line)."""
-    return " ".join(text.split())
+    return terminal_safe(" ".join(text.split()))
 
 
 if __name__ == "__main__":

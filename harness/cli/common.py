@@ -20,6 +20,7 @@ from reference.scene import DIMENSION_RANGE, GYRATION_RANGE, MAX_VERTICES, SCALE
 
 from ..io import json_safe, json_text  # noqa: F401 (json_text re-exported)
 from ..progress import LOGGERS  # ours: INFO with -v/--verbose
+from ..text import terminal_safe
 
 # A number that starts with '-' (also -1e-3, -.5, -inf, -nan): argparse must read it as a
 # value, never as an option.  argparse decides with its parser attribute
@@ -268,14 +269,21 @@ def emit(doc: Any, as_json: bool, text: str) -> None:
     if as_json:
         sys.stdout.write(json_text(doc) + "\n")
     else:
-        print(text)
+        print(terminal_safe(text))
+
+
+class SafeFormatter(logging.Formatter):
+    """Log lines with control characters escaped (harness.text.terminal_safe)."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        return terminal_safe(super().format(record))
 
 
 def configure_logging(verbose: bool) -> None:
     """Our loggers write bare lines to stderr: warnings always, progress (INFO) only with
     -v/--verbose.  Third-party loggers keep Python's default (warnings and above)."""
     handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.setFormatter(SafeFormatter("%(message)s"))
     for name in LOGGERS:
         logger = logging.getLogger(name)
         logger.handlers[:] = [handler]
@@ -291,7 +299,7 @@ def log(msg: str) -> None:
 def note(msg: str) -> None:
     """What the user must see whatever the verbosity (a file written, a run left out):
     one line on stderr."""
-    print(msg, file=sys.stderr, flush=True)
+    print(terminal_safe(msg), file=sys.stderr, flush=True)
 
 
 def add_verbose(parser: argparse.ArgumentParser, top: bool = False) -> None:

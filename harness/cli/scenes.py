@@ -13,7 +13,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from ..scenes import list_builtin
+    from ..text import terminal_safe
 
     for name, desc in list_builtin():
-        print(f"{name:24s} {desc}")
+        print(terminal_safe(f"{name:24s} {desc}"))
     return 0

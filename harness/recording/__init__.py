@@ -1,8 +1,11 @@
 """Rerun recordings (`--record FILE.rrd`): the simulators side by side, built around the
 physics, written offline.  docs/recording.md shows and explains the views.
 
-One `.rrd` file; the views are laid out by `layout.build_blueprint`, embedded with
-`RecordingStream.save(path, default_blueprint=...)`.  Entities:
+One `.rrd` file; the views are laid out by `layout.build_blueprint`, sent as the
+default blueprint.  The recording is encoded into memory (`rr.binary_stream`, no writer
+thread on the disk: a full disk cannot stop rerun's thread and hang the run), checked
+for the RRD header and footer, and written by harness.outputs.write_bytes (atomic,
+fsynced, read back).  Entities:
 
     /<sim>/scene/...                3D: ground, disk (tilt exaggerated), contacts, impact
     /<sim>/attitude/{log10_alpha,heading}     rows (rows.py)
@@ -20,6 +23,7 @@ No global recording is created.
 
 from __future__ import annotations
 
+import time
 import uuid
 from collections.abc import Callable
 from pathlib import Path
@@ -30,7 +34,7 @@ import rerun as rr
 from reference.scene import Scene
 from reference.trajectory import Trajectory
 
-from ..outputs import atomic_write
+from ..outputs import OutputError, show, write_bytes
 from .geometry import exaggeration_schedule
 from .layout import READING, SUMMARY, RowRanges, build_blueprint, focus_range, value_range
 from .raster import log_raster, raster_range
@@ -46,6 +50,13 @@ APPLICATION_ID = "euler_disk_harness"
 # The log rows open on their top 6 decades (a plot ~120 pixels high labels every
 # decade of 6, only every tenth of 9); the log-log plots on the right show all decades.
 ROW_DECADES = 6.0
+# The RRD stream's first bytes and its footer's magic (written last, `rerun rrd verify`).
+RRD_HEADER = b"RRF2"
+RRD_FOOTER = b"RRF2FOOT"
+RRD_FOOTER_TAIL = 64
+# Waits on rerun's encoder thread: slices between which Ctrl-C is seen, and their bound.
+FLUSH_SLICE_S = 0.25
+ENCODE_TIMEOUT_S = 120.0
 __all__ = [
     "APPLICATION_ID",
     "SIM_TIME",
@@ -129,26 +140,54 @@ def _write(
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     if not rr.is_enabled(rec):
         raise RuntimeError("rerun logging is disabled (RERUN=off?): no recording written")
-    with atomic_write(out, force) as tmp:
-        rec.save(tmp, default_blueprint=blueprint)
-        try:
-            names = ", ".join(r.label for r in runs)
-            rec.send_recording_name(f"{scene.name}: {names}")
-            for run in runs:
-                log_scene(rec, run, scene, schedule, tol)
-                log_rows(rec, run)
-            log_raster(rec, runs)
-            if horizons is not None:
-                from .horizon import log_horizon_bands
+    stream = rr.binary_stream(rec)
+    try:
+        rec.send_blueprint(blueprint, make_active=False, make_default=True)
+        names = ", ".join(r.label for r in runs)
+        rec.send_recording_name(f"{scene.name}: {names}")
+        for run in runs:
+            log_scene(rec, run, scene, schedule, tol)
+            log_rows(rec, run)
+        log_raster(rec, runs)
+        if horizons is not None:
+            from .horizon import log_horizon_bands
 
-                log_horizon_bands(rec, runs, horizons, n_contacts)
-            log_energy_plot(rec, runs, e_plot)
-            log_alpha_plot(rec, runs, a_plot)
-            text = summary_markdown(runs, scene, t_max)
-            rec.log(SUMMARY, rr.TextDocument(text, media_type="text/markdown"), static=True)
-            reading = rr.TextDocument(reading_markdown(), media_type="text/markdown")
-            rec.log(READING, reading, static=True)
-        finally:
-            rec.flush()
-            rec.disconnect()  # closes the file sink: footer and manifest are written
+            log_horizon_bands(rec, runs, horizons, n_contacts)
+        log_energy_plot(rec, runs, e_plot)
+        log_alpha_plot(rec, runs, a_plot)
+        text = summary_markdown(runs, scene, t_max)
+        rec.log(SUMMARY, rr.TextDocument(text, media_type="text/markdown"), static=True)
+        reading = rr.TextDocument(reading_markdown(), media_type="text/markdown")
+        rec.log(READING, reading, static=True)
+        data = encoded_bytes(stream, out)
+    finally:
+        rec.disconnect()
+    write_bytes(out, data, force)
+    return out
+
+
+def encoded_bytes(stream: rr.BinaryStream, out: Path, timeout_s: float = ENCODE_TIMEOUT_S) -> bytes:
+    """The whole recording as RRD bytes, footer included, from rerun's in-memory sink.
+
+    The encoder thread is waited for in short slices (Ctrl-C is handled between them) and
+    for at most `timeout_s` in all; bytes that do not start with the RRD header or end
+    with its footer are refused (OutputError) instead of written."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            stream.flush(timeout_sec=FLUSH_SLICE_S)
+            break
+        except Exception as exc:  # rerun raises a plain exception on a timeout
+            if time.monotonic() > deadline:
+                raise OutputError(
+                    f"cannot write {show(out)}: rerun did not finish encoding the recording "
+                    f"within {timeout_s:g} s ({exc})"
+                ) from None
+    data = stream.read(flush=False) or b""
+    if not (data.startswith(RRD_HEADER) and RRD_FOOTER in data[-RRD_FOOTER_TAIL:]):
+        raise OutputError(
+            f"cannot write {show(out)}: rerun's encoder returned an incomplete recording "
+            f"({len(data)} bytes, no RRD footer)"
+        )
+    return data
     return out

@@ -19,7 +19,12 @@ fidelity rows, the exponent map from the sweep's per-point means), by the same f
 the commands use, and embedded as a PNG data URI.  The file loads nothing from anywhere:
 no scripts, no external styles, fonts or images; it opens offline in any browser and
 can be mailed or archived alone.  The one link out is to a compare run's `.rrd`
-recording (relative to the report's folder), which the browser cannot show anyway.
+recording (relative to the report's folder), which the browser cannot show anyway; only
+relative file paths and http(s) URLs are ever linked (links.py).
+
+Every JSON input is checked against its kind's schema (schema.py) before any HTML is
+built: a missing or mistyped field is one line naming it (exit 2).  Every string taken
+from an input is HTML-escaped (html.esc).
 """
 
 from __future__ import annotations
@@ -29,8 +34,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from reference.scene import input_file_problem
+from reference.scene import show_path as show
+
 from .html import details, esc, page
 from .restitution import restitution_section
+from .schema import SchemaError, check_document
 from .sections import (
     bench_section,
     compare_section,
@@ -89,17 +98,25 @@ def load_inputs(path: str | Path) -> list[ReportInput]:
     p = Path(path)
     if p.is_dir():
         return _sweep_directory(p)
-    if not p.is_file():
-        raise ReportInputError(f"{p}: no such file or directory")
+    problem = input_file_problem(p)
+    if problem:
+        raise ReportInputError(f"{show(p)}: {problem}")
     try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
+        doc = json.loads(p.read_text(encoding="utf-8-sig"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ReportInputError(f"{p}: not a JSON document ({exc})") from None
+        raise ReportInputError(f"{show(p)}: not a JSON document ({exc})") from None
+    except OSError as exc:
+        raise ReportInputError(f"{show(p)}: cannot be read ({exc.strerror})") from None
     kind = detect_kind(doc)
     if kind is None:
         raise ReportInputError(
-            f"{p}: not a result of harness compare, bench, fidelity, stress, sweep or restitution"
+            f"{show(p)}: not a result of harness compare, bench, fidelity, stress, sweep or "
+            "restitution"
         )
+    try:
+        check_document(doc, kind)
+    except SchemaError as exc:
+        raise ReportInputError(f"{show(p)}: not a valid {kind} document: {exc}") from None
     return [ReportInput(p, kind, doc)]
 
 

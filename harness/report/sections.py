@@ -4,11 +4,11 @@ fractions, sweep points → exponent map), so a report depends on no file but it
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any
 
 from .html import Cell, details, esc, figure, num, paragraph, table
+from .links import file_href, url_scheme
 
 # ----------------------------------------------------------------------------- provenance
 
@@ -157,12 +157,14 @@ def _horizon_paragraphs(doc: dict[str, Any]) -> str:
 
 
 def recording_link(path: str | None, out_dir: Path) -> str:
-    """A relative link to the run's .rrd recording (open it with `rerun FILE`)."""
+    """A relative link to the run's .rrd recording (open it with `rerun FILE`); an
+    http(s) URL as it is; nothing else (harness.report.links)."""
     if not path:
         return paragraph("No recording was made (compare --record FILE.rrd makes one).", "muted")
     target = Path(path)
-    href = os.path.relpath(target.resolve(), out_dir.resolve())
-    found = "" if target.exists() else " (not found when this report was written)"
+    href = file_href(path, out_dir)
+    missing = not url_scheme(path) and not target.exists()
+    found = " (not found when this report was written)" if missing else ""
     return (
         f'<p>Recording: <a href="{esc(href)}">{esc(target.name)}</a>{esc(found)}; open it with '
         f"<code>rerun {esc(target.name)}</code> (docs/recording.md).</p>"

@@ -32,45 +32,33 @@ import fnmatch
 import json
 import os
 import time
-import uuid
 from pathlib import Path
 
 import pyarrow as pa
 import pyarrow.dataset as ds
-import pyarrow.parquet as pq
 
-from ..outputs import OutputError, check_directory, show
-from .grid import SweepConfig
-
-KEY = ("i_restitution", "i_gyration", "sample")
-
-SCHEMA = pa.schema(
-    [
-        ("engine", pa.string()),
-        ("n", pa.int32()),
-        ("seed", pa.int64()),
-        ("i_restitution", pa.int32()),
-        ("i_gyration", pa.int32()),
-        ("sample", pa.int32()),
-        ("gyration", pa.float64()),
-        ("restitution", pa.float64()),
-        ("status", pa.string()),
-        ("c", pa.float64()),
-        ("c_stderr", pa.float64()),
-        ("t_singularity", pa.float64()),
-        ("n_impacts", pa.int64()),
-        ("fit_decades", pa.float64()),
-        ("c_decades", pa.float64()),
-        ("c_period", pa.float64()),
-        ("message", pa.string()),
-        ("error", pa.string()),
-        ("q0", pa.list_(pa.float64())),
-        ("p0", pa.list_(pa.float64())),
-        ("dt", pa.float64()),
-        ("wall_time_s", pa.float64()),
-        ("cpu_time_s", pa.float64()),
-    ]
+from ..outputs import (
+    OutputError,
+    cannot_write,
+    check_directory,
+    remove_stale_temporaries,
+    show,
+    write_bytes,
 )
+from .grid import SweepConfig
+from .parts import (
+    KEY,
+    SCHEMA,
+    Refused,
+    config_difference,
+    part_bytes,
+    part_name,
+    rows_mismatch,
+    stored_config,
+    verify_parts,
+)
+
+__all__ = ["KEY", "SCHEMA", "StoreError", "SweepStore", "load_results", "rows_mismatch"]
 
 
 class StoreError(Exception):
@@ -81,7 +69,7 @@ _UNREADABLE = object()
 # What a sweep writes: in the study directory, in an engine's directory, in its parts/.
 ROOT_FILES = ("compare-*.png",)
 ENGINE_FILES = ("manifest.json", "manifest.json.*", ".lock", "*.png")
-PART_FILES = ("part-*.parquet", "part-*.parquet.corrupt-*", ".tmp-*")
+PART_FILES = ("part-*.parquet", "part-*.parquet.*-*", ".tmp-*")
 TEMP_FILES = (".tmp-*", ".harness-tmp-*")
 
 
@@ -148,41 +136,8 @@ def _read_json(path: Path):
         return _UNREADABLE
 
 
-def rows_mismatch(df, config: SweepConfig) -> str:
-    """Why stored rows cannot belong to `config` ('' when they all can): engine, n, seed,
-    indices within the grid, the grid values at those indices, and dt."""
-    if not len(df):
-        return ""
-    for col, want in (("engine", config.engine), ("n", config.n), ("seed", config.seed)):
-        if not (df[col] == want).all():
-            return f"{col} {sorted(set(df[col].tolist()))[:3]} (now {want!r})"
-    rho, gam = config.rho_values, config.gamma_values
-    ir, ig, s = df["i_gyration"], df["i_restitution"], df["sample"]
-    if not (ir.between(0, len(rho) - 1).all() and ig.between(0, len(gam) - 1).all()):
-        return "grid indices beyond this grid"
-    if not s.between(0, config.samples - 1).all():
-        return f"samples beyond {config.samples}"
-    if not ((df["gyration"] == rho[ir]).all() and (df["restitution"] == gam[ig]).all()):
-        return "other grid values"
-    dt_ok = df["dt"].isna().all() if config.dt is None else (df["dt"] == config.dt).all()
-    return "" if dt_ok else "another dt"
-
-
 def engine_dir(root: str | Path, engine: str) -> Path:
     return Path(root) / engine
-
-
-def _write_atomic(path: Path, write) -> None:
-    tmp = path.with_name(f".tmp-{uuid.uuid4().hex}-{path.name}")
-    try:
-        with open(tmp, "wb") as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 class SweepStore:
@@ -198,51 +153,69 @@ class SweepStore:
     # -- opening -------------------------------------------------------------------
     def open(self) -> SweepStore:
         """Create or reopen the directory: check it is a study directory, take the lock,
-        remove temporary files left by a killed run, set aside damaged parts, check or
-        write the manifest (module docstring).  `self.results` holds the stored rows
-        (DataFrame, duplicates dropped) and `self.notes` what was set aside."""
+        remove temporary files left by a killed run, check or write the manifest, set
+        aside the parts that do not belong (harness.sweep.parts; module docstring).
+        `self.results` holds the stored rows (DataFrame sorted by key, 0 duplicates:
+        duplicated parts are refused) and `self.notes` what was set aside and why.
+        A file system error ends as StoreError naming the path and the cause."""
         check_study_dir(self.root, self.config.engine)
-        self.parts_dir.mkdir(parents=True, exist_ok=True)
-        self._lock()
         try:
-            for tmp in self.parts_dir.glob(".tmp-*"):
-                tmp.unlink(missing_ok=True)
-            table, bad = scan_parts(self.parts_dir)
-            self.notes = [f"set aside unreadable part {set_aside(p, 'corrupt').name}" for p in bad]
-            self.results = _frame(table)
-            self._check_manifest()
+            self.parts_dir.mkdir(parents=True, exist_ok=True)
+            self._lock()
+        except OSError as exc:
+            raise StoreError(cannot_write(exc.filename or self.dir, exc)) from None
+        try:
+            self._open_locked()
+        except OSError as exc:
+            self.close()
+            raise StoreError(cannot_write(exc.filename or self.dir, exc)) from None
         except BaseException:
             self.close()
             raise
         return self
 
+    def _open_locked(self) -> None:
+        for tmp in self.parts_dir.glob(".tmp-*"):  # temporaries of earlier versions
+            tmp.unlink(missing_ok=True)
+        for folder in (self.root, self.dir, self.parts_dir):  # a run killed mid-write
+            remove_stale_temporaries(folder)
+        self.notes: list[str] = []
+        self._check_manifest()
+        table, refused = verify_parts(self.parts_dir, self.config)
+        self.refused = refused
+        for r in refused:
+            aside = set_aside(r.path, r.kind)
+            self.notes.append(f"set aside {r.kind} part {aside.name}: {r.why}")
+        self.results = _frame(table)
+
     def _check_manifest(self) -> None:
+        """The manifest, else the parameters the intact parts carry, must be this
+        sweep's while runs are stored (StoreError otherwise); a manifest over no runs is
+        set aside; a missing or unreadable one is rewritten."""
         manifest = self.dir / "manifest.json"
         want = self.config.to_dict()
         have = _read_json(manifest) if manifest.exists() else None
-        df = self.results[0]
         if have is _UNREADABLE:
             self.notes.append(f"set aside unreadable {set_aside(manifest, 'corrupt').name}")
             have = None
+        if have == want:
+            return
+        stored = stored_config(self.parts_dir)
         if have is not None:
-            diff = sorted(k for k in set(have) | set(want) if have.get(k) != want.get(k))
-            if not diff:
-                return
-            if len(df):
-                what = ", ".join(f"{k}={have.get(k)!r} (now {want.get(k)!r})" for k in diff)
+            if stored is not None:
                 raise StoreError(
-                    f"{self.dir} holds a sweep with other parameters: {what}; "
+                    f"{self.dir} holds a sweep with other parameters: "
+                    f"{config_difference(have, want)}; "
                     "rerun with the same parameters to resume, or use another --out"
                 )
             self.notes.append(f"set aside {set_aside(manifest, 'unused').name} (no runs stored)")
-        mismatch = rows_mismatch(df, self.config)
-        if mismatch:
+        elif stored is not None and stored != want:
             raise StoreError(
                 f"{self.dir} has no readable manifest and its stored runs belong to another "
-                f"sweep ({mismatch}); use another --out"
+                f"sweep ({config_difference(stored, want)}); use another --out"
             )
         text = json.dumps(want, indent=1, sort_keys=True).encode()
-        _write_atomic(manifest, lambda fh: fh.write(text))
+        write_bytes(manifest, text, force=True)
 
     def _lock(self) -> None:
         fh = open(self.dir / ".lock", "a+")
@@ -267,11 +240,11 @@ class SweepStore:
 
     # -- writing -------------------------------------------------------------------
     def write_part(self, rows: list[dict], label: str) -> Path:
-        """Persist the rows of one finished chunk as a new part (atomic)."""
-        table = pa.Table.from_pylist(rows, schema=SCHEMA)
-        path = self.parts_dir / f"part-{label}-{uuid.uuid4().hex[:8]}.parquet"
-        _write_atomic(path, lambda fh: pq.write_table(table, fh))
-        return path
+        """Persist the rows of one finished chunk as a new part: atomic, fsynced, read
+        back, named by its content hash (harness.sweep.parts); OutputError naming the
+        path and the cause when it cannot be written."""
+        data = part_bytes(rows, self.config)
+        return write_bytes(self.parts_dir / part_name(label, data), data)
 
     # -- reading -------------------------------------------------------------------
     def part_paths(self) -> list[Path]:
@@ -319,12 +292,28 @@ def _frame(table: pa.Table):
 
 
 def load_results(sweep_dir: str | Path):
-    """(DataFrame of unique rows sorted by key, number of duplicate rows dropped).
+    """(DataFrame of the rows of the parts that belong to the directory's manifest,
+    sorted by key; number of parts refused: harness.sweep.parts).  Nothing is renamed
+    here (SweepStore.open does that).  Without a readable manifest, the parameters most
+    intact parts carry stand for it."""
+    config = _config_of(sweep_dir)
+    if config is None:
+        return _frame(SCHEMA.empty_table())[0], 0
+    table, refused = verify_parts(Path(sweep_dir) / "parts", config)
+    return _frame(table)[0], len(refused)
 
-    Duplicates cannot arise from one sweep (a rerun computes only missing keys and the
-    lock forbids two writers); if parts were copied in by hand, the first part (by
-    name) wins."""
-    return _frame(read_parts(Path(sweep_dir) / "parts"))
+
+def refused_parts(sweep_dir: str | Path) -> list[Refused]:
+    config = _config_of(sweep_dir)
+    return [] if config is None else verify_parts(Path(sweep_dir) / "parts", config)[1]
+
+
+def _config_of(sweep_dir: str | Path) -> SweepConfig | None:
+    config = read_manifest(sweep_dir)
+    if config is None:
+        stored = stored_config(Path(sweep_dir) / "parts")
+        config = None if stored is None else SweepConfig.from_dict(stored)
+    return config
 
 
 def read_manifest(sweep_dir: str | Path) -> SweepConfig | None:

@@ -36,7 +36,8 @@ geometric decay of the recent intervals per decade of speed; this T is the only
 approximation (it moves the state by about decouple_tol × (error of T)/T relative).  If
 another contact is then at the ground within roundoff, the accumulation is undecidable.
 
-Code layout.  `simulate_kernel` sets up and runs `_step` until a status is set: an impact
+Code layout.  `start_kernel` sets up, `continue_kernel` runs `_step` (at most a budget of
+passes per call, so that Python sees Ctrl-C between calls) until a status is set: an impact
 now (`_impact_step`: the impact map, renormalisation, chatter completion), else the held
 set and the motion to the next event (`_flight_step`).  The helpers share the run through
 small tuples and arrays, unpacked at their top:
@@ -61,7 +62,7 @@ from numba import njit
 from ..core.clock import time_until
 from ..core.tolerances import EPS  # unit roundoff of a double (one definition)
 
-# The event loop's helpers allocate nothing: they are compiled inline into simulate_kernel
+# The event loop's helpers allocate nothing: they are compiled inline into continue_kernel
 # (LLVM alwaysinline) and without reference counting (numba's own idiom for allocation-free
 # helpers, e.g. numba.misc.mergesort).  Measured: as ordinary njit functions the split
 # event loop ran 2.5-3 times slower than the single function it replaced.
@@ -1011,49 +1012,47 @@ def _finish(model, state, out, si, sf, info):
     _write_info(si, info)
 
 
-@njit(cache=True)
-def simulate_kernel(
-    F,
-    thd,
-    mass,
-    g,
-    gamma,
-    rank_f,
-    q_init,
-    p_init,
-    t_end,
-    max_impacts,
-    log2_energy_floor,
-    chatter_tol,
-    decouple_tol,
-    record_states,
-    out_i,
-    out_f,
-    out_s,
-    info,
-):
-    """Run the linear model from (q_init, p_init) at t = 0 (module docstring).
+def new_loop_state(n_contacts: int):
+    """The arrays a run carries between calls of `continue_kernel` (module docstring:
+    state, ring, si, sf), allocated once by the caller."""
+    return (
+        np.zeros(3),  # q
+        np.zeros(3),  # p
+        np.zeros(3),  # qs
+        np.zeros(3),  # ps
+        np.zeros(3),  # acc
+        np.full(3, -1, dtype=np.int64),  # held
+        np.zeros(n_contacts, dtype=np.bool_),  # closed
+        np.zeros(N_SI, dtype=np.int64),  # si
+        np.zeros(N_SF),  # sf
+        np.full(RB, -1, dtype=np.int64),  # ring: contact
+        np.zeros(RB),  # ring: log2 interval
+        np.zeros(RB),  # ring: log2 speed
+    )
 
-    One row per event in out_i (N, N_ICOLS), out_f (N, N_FCOLS) and, if record_states,
-    out_s (N, N_SCOLS); info receives status, number of events and impacts, the contacts
-    of an undecidable event and a reason code.  Stops (SINGULARITY) once log2 of the
-    true energy falls below `log2_energy_floor`.  Returns the number of events."""
-    nc = F.shape[0]
-    tinv = 1.0 / thd
-    w, wmax = _contact_products(F, tinv)
+
+@njit(cache=True)
+def start_kernel(
+    F, thd, tinv, w, wmax, mass, g, gamma, rank_f, q_init, p_init, record_states,
+    out_i, out_f, out_s, info, q, p, qs, ps, acc, held, closed, si, sf,
+):  # fmt: skip
+    """Set up a run from (q_init, p_init) at t = 0 (module docstring) in the caller's
+    state arrays (`new_loop_state`).  Returns True when the run ended at once (no energy
+    above the contacts: SINGULARITY), else False: call `continue_kernel`."""
     model = (F, thd, tinv, w, wmax, mass, gamma, rank_f)
-    limits = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol)
     out = (out_i, out_f, out_s, record_states)
-    q = q_init.copy()
-    p = p_init.copy()
-    held = np.full(3, -1, dtype=np.int64)
-    acc = np.zeros(3)
+    state = (q, p, qs, ps, acc, held, closed)
+    q[:] = q_init
+    p[:] = p_init
+    qs[:] = 0.0
+    ps[:] = 0.0
+    held[:] = -1
+    acc[:] = 0.0
     acc[2] = -g
-    closed = np.zeros(nc, dtype=np.bool_)
-    state = (q, p, np.zeros(3), np.zeros(3), acc, held, closed)
-    si = np.zeros(N_SI, dtype=np.int64)
+    closed[:] = False
+    si[:] = 0
     si[SI_STATUS] = -1
-    sf = np.zeros(N_SF)
+    sf[:] = 0.0
     sf[SF_GRAVITY] = g
     info[:] = 0
     E = _energy(q, p, thd, mass, g)
@@ -1062,15 +1061,36 @@ def simulate_kernel(
         si[SI_EVENTS] = 1
         _stop(si, info, SINGULARITY, 3, -1, -1)
         _write_info(si, info)
-        return si[SI_EVENTS]
+        return True
     _start(model, state, out, si, sf, E)
+    return False
+
+
+@njit(cache=True)
+def continue_kernel(
+    F, thd, tinv, w, wmax, mass, gamma, rank_f, t_end, max_impacts, log2_energy_floor,
+    chatter_tol, decouple_tol, record_states, out_i, out_f, out_s, info,
+    q, p, qs, ps, acc, held, closed, si, sf, rb_c, rb_ldt, rb_lu, budget,
+):  # fmt: skip
+    """At most `budget` passes of the event loop (`_step`), so that the caller regains
+    control (Ctrl-C) between calls.  Returns the number of events once a status is set
+    (after `_finish`: END row, outcome record), else -1: call again."""
+    nc = F.shape[0]
+    model = (F, thd, tinv, w, wmax, mass, gamma, rank_f)
+    limits = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol)
+    out = (out_i, out_f, out_s, record_states)
+    state = (q, p, qs, ps, acc, held, closed)
     cidx = np.zeros(nc + 3, dtype=np.int64)
     hidx = np.zeros(3, dtype=np.int64)
     sidx = np.zeros(3, dtype=np.int64)
     scratch = (np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), cidx, hidx, sidx)
-    ring = (np.full(RB, -1, dtype=np.int64), np.zeros(RB), np.zeros(RB))
-    while si[SI_STATUS] < 0:
+    ring = (rb_c, rb_ldt, rb_lu)
+    steps = 0
+    while si[SI_STATUS] < 0 and steps < budget:
         _step(model, limits, state, scratch, ring, out, si, sf, info)
+        steps += 1
+    if si[SI_STATUS] < 0:
+        return -1
     _finish(model, state, out, si, sf, info)
     return si[SI_EVENTS]
 

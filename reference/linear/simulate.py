@@ -18,7 +18,12 @@ import numpy as np
 
 from ..trajectory import ImpactEvent, Phase, Status, Trajectory
 from . import kernel as K
+from .domain import cut_at_exit, first_exit
 from .model import LinearModel, full_states, linear_state
+
+# Passes of the linear event loop per call of the compiled kernel: Python regains control
+# (Ctrl-C) every few tens of milliseconds (one pass is ~0.1-3 µs).
+LOOP_BUDGET = 50_000
 
 STATUS = {
     K.T_END: Status.T_END,
@@ -138,27 +143,23 @@ def run_linear(
     out_f = np.empty((cap, K.N_FCOLS))
     out_s = np.zeros((cap if record_states else 1, K.N_SCOLS))
     info = np.zeros(K.N_INFO, dtype=np.int64)
+    tinv = 1.0 / model.theta
+    w, wmax = K._contact_products(F, tinv)
+    consts = (F, model.theta, tinv, w, wmax, model.mass)
+    loop = K.new_loop_state(F.shape[0])
     t0 = time.perf_counter()
-    n = K.simulate_kernel(
-        F,
-        model.theta,
-        model.mass,
-        model.gravity,
-        model.restitution,
-        model.rank,
-        q0,
-        p0,
-        float(t_end),
-        int(max_impacts),
-        float(log2_floor),
-        float(chatter_tol),
-        float(decouple_tol),
-        bool(record_states),
-        out_i,
-        out_f,
-        out_s,
-        info,
-    )
+    done = K.start_kernel(
+        *consts, model.gravity, model.restitution, model.rank, q0, p0, bool(record_states),
+        out_i, out_f, out_s, info, *loop[:9],
+    )  # fmt: skip
+    while not done:  # back in Python every LOOP_BUDGET events: Ctrl-C works
+        n = K.continue_kernel(
+            *consts, model.restitution, model.rank, float(t_end), int(max_impacts),
+            float(log2_floor), float(chatter_tol), float(decouple_tol), bool(record_states),
+            out_i, out_f, out_s, info, *loop, LOOP_BUDGET,
+        )  # fmt: skip
+        done = n >= 0
+    n = int(loop[7][K.SI_EVENTS])
     wall = time.perf_counter() - t0
     status = STATUS[int(info[0])]
     reason = int(info[5])
@@ -243,19 +244,22 @@ def simulate_linear(
     reference.geometry.energies of the mapped full state by ½ (I3 − I1)(ω·e3)²
     with ω·e3 = ωx φy − ωy φx, i.e. by O(α²) relative.
 
-    Status as the reference: simultaneous_impact when undecidable, singularity when all
-    contacts are down (t_singularity exact) or the energy fell below `energy_floor` of
-    its initial value (t_singularity extrapolated from the last energy decades, see
-    exponent.extrapolate_time_to_go), t_end, max_impacts.  Chatter sequences are
-    completed in closed form (kernel.py); they are listed in stats["accumulations"], not
-    as impacts."""
+    Status as the reference: left_model once the tilt leaves the model's small-tilt
+    domain (domain.TILT_LIMIT; the run is cut there), simultaneous_impact when
+    undecidable, singularity when all contacts are down (t_singularity exact) or the
+    energy fell below `energy_floor` of its initial value (t_singularity extrapolated
+    from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
+    max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
+    listed in stats["accumulations"], not as impacts."""
+    from ..checks import check_linear_options, run_horizon
     from ..scenes import as_scene
     from .exponent_estimates import extrapolate_time_to_go
 
     scene = as_scene(scene)
+    t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
+    check_linear_options(sample_dt, energy_floor, chatter_tol)
     model = LinearModel.from_scene(scene)
     q0, p0 = linear_state(scene)
-    t_end = float(scene.run.t_end if t_end is None else t_end)
     run = run_linear(
         model,
         q0,
@@ -265,6 +269,9 @@ def simulate_linear(
         energy_floor=energy_floor,
         chatter_tol=chatter_tol,
     )
+    exit_at = first_exit(run)
+    if exit_at is not None:  # beyond the small tilts the model holds for (domain.py)
+        run = cut_at_exit(run, *exit_at)
     t_sing = None
     t_final = run.t_final
     if run.status is Status.SINGULARITY:
