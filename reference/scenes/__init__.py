@@ -70,5 +70,12 @@ def list_builtin() -> list[tuple[str, str]]:
 
 def as_scene(scene: Scene | str | Path) -> Scene:
     """A Scene as given, or the one a file path or built-in name gives (resolve_scene):
-    every function that takes a scene takes a name too."""
-    return scene if isinstance(scene, Scene) else resolve_scene(scene)
+    every function that takes a scene takes a name too.  Anything else is refused with
+    SceneError (reference.checks.run_horizon's message)."""
+    if isinstance(scene, Scene):
+        return scene
+    if not isinstance(scene, str | Path):
+        raise SceneError(
+            f"a Scene, a scene file or a built-in scene name is needed, got {type(scene).__name__}"
+        )
+    return resolve_scene(scene)
