@@ -77,7 +77,9 @@ def test_unusable_linear_options_are_refused(scene, options, field):
 
 
 def test_a_scene_that_is_no_scene_is_refused():
-    with pytest.raises(SceneError, match="a Scene, a scene file or a built-in scene name is needed"):
+    with pytest.raises(
+        SceneError, match="a Scene, a scene file or a built-in scene name is needed"
+    ):
         reference.simulate({"body": {"n": 3}}, t_end=1.0)
 
 
