@@ -40,6 +40,7 @@ import numpy as np
 from mujoco import rollout
 
 from reference import quaternion as qt
+from reference.core import layout as L
 from reference.geometry import free_acceleration, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
@@ -61,9 +62,10 @@ def to_mujoco_state(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reference state [x, q wxyz, v, ω world] (13) → MuJoCo (qpos (7), qvel (6)) with
     qvel's angular part in the body frame: ω_body = R(q)ᵀ ω_world."""
     y = np.asarray(y, dtype=float)
-    q = y[3:7]
+    q = y[L.QUATERNION]
     q_inv = np.array([q[0], -q[1], -q[2], -q[3]])
-    return y[0:7].copy(), np.concatenate([y[7:10], qt.rotate(q_inv, y[10:13])])
+    pose = np.concatenate([y[L.POSITION], q])
+    return pose, np.concatenate([y[L.VELOCITY], qt.rotate(q_inv, y[L.ANGULAR_VELOCITY])])
 
 
 def from_mujoco_state(qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:

@@ -33,6 +33,7 @@ from .contacts import (
 )
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
+from .layout import VZ, Z
 from .records import (
     EVENT_ACTIVATION,
     EVENT_IMPACT,
@@ -122,8 +123,8 @@ def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
     best = k = first % n
     for _ in range(count):
         cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
-        g = max(y[2] + cx * px + cy * py, TINY)
-        g1 = y[9] + cx * qx + cy * qy
+        g = max(y[Z] + cx * px + cy * py, TINY)
+        g1 = y[VZ] + cx * qx + cy * qy
         if not p2_positive_at(g, g1, K, best_d):  # (else it cannot come first)
             d = quadratic_first_root(g, g1, K)
             if d < best_d:

@@ -31,6 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core import layout as L
+
 U3 = np.array([0.0, 0.0, 1.0])
 
 
@@ -209,17 +211,17 @@ def full_states(q: np.ndarray, p: np.ndarray) -> np.ndarray:
     q = np.atleast_2d(q)
     p = np.atleast_2d(p)
     N = len(q)
-    y = np.zeros((N, 13))
-    y[:, 2] = q[:, 2]
+    y = np.zeros((N, L.STATE_SIZE))
+    y[:, L.Z] = q[:, 2]
     theta = np.hypot(q[:, 0], q[:, 1])
     small = theta < 1e-4
     t2 = theta * theta
     with np.errstate(invalid="ignore", divide="ignore"):
         hs = np.where(small, 0.5 - t2 / 48.0 + t2 * t2 / 3840.0, np.sin(0.5 * theta) / theta)
-    y[:, 3] = np.cos(0.5 * theta)
-    y[:, 4] = hs * q[:, 0]
-    y[:, 5] = hs * q[:, 1]
-    y[:, 9] = p[:, 2]
-    y[:, 10] = p[:, 0]
-    y[:, 11] = p[:, 1]
+    y[:, L.QW] = np.cos(0.5 * theta)
+    y[:, L.QX] = hs * q[:, 0]
+    y[:, L.QY] = hs * q[:, 1]
+    y[:, L.VZ] = p[:, 2]
+    y[:, L.WX] = p[:, 0]
+    y[:, L.WY] = p[:, 1]
     return y
