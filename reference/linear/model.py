@@ -63,9 +63,14 @@ def theta_diag(mass: float, inertia: float) -> np.ndarray:
 
 
 def impact_matrix(f: np.ndarray, theta: np.ndarray, gamma: float) -> np.ndarray:
-    """U = I − (1+γ) Θ⁻¹ f fᵀ / (fᵀ Θ⁻¹ f) (eq. impactequ); `theta` is diag(Θ)."""
+    """U with p⁺ = U p⁻ for an impact at the contact of row f (eq. impactequ; `theta` is
+    diag(Θ)): p⁺ = p⁻ + Θ⁻¹ f λ with the exact core's impulse λ(u⁻) of the normal
+    velocity u⁻ = fᵀp⁻ and w = fᵀ Θ⁻¹ f (reference.core.impact.impact_impulse), linear
+    in u⁻ (Newton's law), so U = I + λ(1) Θ⁻¹ f fᵀ = I − (1+γ) Θ⁻¹ f fᵀ / (fᵀ Θ⁻¹ f)."""
+    from ..core.impact import impact_impulse  # (numba: imported when an impact is formed)
+
     tf = f / theta
-    return np.eye(3) - (1.0 + gamma) * np.outer(tf, f) / float(f @ tf)
+    return np.eye(3) + impact_impulse(1.0, float(f @ tf), gamma) * np.outer(tf, f)
 
 
 def free_acceleration(gravity: float) -> np.ndarray:
@@ -93,9 +98,13 @@ def contact_acceleration(f: np.ndarray, theta: np.ndarray, mass: float, gravity:
     return held_acceleration(f[None, :], theta, mass, gravity)[0]
 
 
-def energy(q: np.ndarray, p: np.ndarray, theta: np.ndarray, mass: float, gravity: float):
-    """E = ½ pᵀΘp + m g h: exactly conserved by the linear flight and contact phases."""
-    return 0.5 * float(p @ (theta * p)) + mass * gravity * float(q[2])
+def energy(q, p, theta, mass: float, gravity: float) -> float:
+    """E = ½ pᵀΘp + m g h: exactly conserved by the linear flight and contact phases.
+    Plain arithmetic on the three components, so that the linear kernel compiles this
+    same function (kernel._energy)."""
+    return 0.5 * (theta[0] * p[0] * p[0] + theta[1] * p[1] * p[1] + theta[2] * p[2] * p[2]) + (
+        mass * gravity * q[2]
+    )
 
 
 @dataclass(frozen=True)
@@ -185,7 +194,7 @@ class LinearModel:
         return free_acceleration(self.gravity)
 
     def energy(self, q, p) -> float:
-        return energy(np.asarray(q), np.asarray(p), self.theta, self.mass, self.gravity)
+        return float(energy(np.asarray(q), np.asarray(p), self.theta, self.mass, self.gravity))
 
     @property
     def rank(self) -> int:
