@@ -31,9 +31,15 @@ from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTO
 
 @hot
 def contact_kind(model, k):
-    """The kind of the ground's contact k: its rim vertices come first (model.n_rim of
-    them), its floor points after."""
-    return RIM_VERTEX_ON_PLANE if k < model.n_rim else FLOOR_POINT_ON_FACE
+    """The kind of the ground's contact k (`kind_in_ground` with model.n_rim)."""
+    return kind_in_ground(model.n_rim, k)
+
+
+@hot
+def kind_in_ground(n_rim, k):
+    """The kind of contact k of a ground whose rim vertices come first (n_rim of them)
+    and its floor points after (for loops over contacts, n_rim read once)."""
+    return RIM_VERTEX_ON_PLANE if k < n_rim else FLOOR_POINT_ON_FACE
 
 
 @hot
@@ -150,8 +156,8 @@ def frame_and_rate(y, cols, kind, pts, k):
     first two columns, `rotation.rotation_columns_xy`, used by a rim vertex)."""
     if kind == RIM_VERTEX_ON_PLANE:
         f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
-    else:
-        f = contact_frame(y, kind, pts, k)
+    else:  # FLOOR_POINT_ON_FACE
+        f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
     return f, normal_velocity(y, f, kind)
 
 
@@ -182,10 +188,10 @@ def contact_jet(y, kind, pts, k, acc):
     accelerations acc."""
     if kind == RIM_VERTEX_ON_PLANE:
         return point_jet(y, pts[k, 0], pts[k, 1], acc)
-    f = contact_frame(y, kind, pts, k)
-    return Jet(
-        f.gap, normal_velocity(y, f, kind), normal_acceleration(y, f, acc, kind, pts, k), f.noise
-    )
+    bx, by, bz = pts[k, 0], pts[k, 1], pts[k, 2]  # FLOOR_POINT_ON_FACE
+    f = bump_frame(y, bx, by, bz)
+    accel = bump_normal_acceleration(y, f, acc, bx, by, bz)
+    return Jet(f.gap, normal_velocity(y, f, kind), accel, f.noise)
 
 
 @hot

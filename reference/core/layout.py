@@ -15,3 +15,5 @@ POSITION = slice(X, Z + 1)
 QUATERNION = slice(QW, QZ + 1)
 VELOCITY = slice(VX, VZ + 1)
 ANGULAR_VELOCITY = slice(WX, WZ + 1)
+POSE = slice(X, QZ + 1)  # (x, q): MuJoCo's qpos
+VELOCITIES = slice(VX, WZ + 1)  # (v, ω): what an impulse or an acceleration changes
