@@ -1,22 +1,45 @@
-"""Contact geometry for one state (the model of Baranyai & Várkonyi, section 2):
+"""The contact kinds: the geometry of one contact at a state (the model of Baranyai &
+Várkonyi, section 2).  A ground is a list of contacts, each of a kind
+(`records.RIM_VERTEX_ON_PLANE`, `records.FLOOR_POINT_ON_FACE`): its rim vertices first,
+contacts 0 … model.n_rim − 1, then its floor points (`contact_kind`).  `pts[k]` is
+contact k's point: body-frame for a rim vertex, world for a floor point.
 
-- flat ground: contact k is vertex k at body position p_k = a(cos 2πk/n, sin 2πk/n, 0);
-  lever r = R p_k, gap g = z + r_z, normal n = e_z (paper eq. rig, exact in α);
-- three-point ground: contact k is the bump b_k = b(cos 2πk/3, sin 2πk/3, 0) under the
-  body's face (normal e3 = R ẑ through the centre of mass): with d = x − b_k, gap
-  g = d·e3, normal n = e3, lever r = −d + g e3 (the in-plane part of b_k − x).
+- RIM_VERTEX_ON_PLANE: the body point p_k = a(cos 2πk/n, sin 2πk/n, 0) against the
+  plane z = 0; lever r = R p_k, gap g = z + r_z, normal n = e_z (paper eq. rig, exact
+  in α);
+- FLOOR_POINT_ON_FACE: the fixed world point b_k under the body's face (normal
+  e3 = R ẑ through the centre of mass): with d = x − b_k, gap g = d·e3, normal
+  n = e3, lever r = −d + g e3 (the in-plane part of b_k − x); the model has no such
+  contact once the point is outside the face's rim (`off_face`).
 
 Either way the normal velocity is g′ = n·(v + ω × r) and the normal acceleration is
-g″ = J (v̇, ω̇) + bias with J = [nᵀ, (r × n)ᵀ] (paper eq. rollc).  `pts` holds the
-body-frame vertices (flat) or the world bumps (three-point).  Accelerations `acc` are
-tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
+g″ = J (v̇, ω̇) + bias with J = [nᵀ, (r × n)ᵀ] (paper eq. rollc); the impulse response
+is the kind-free `inertia.impulse_response` of the frame.  Each function below takes
+the contact's kind and branches on it, the only place the core asks for it; the
+derivative bounds of the event search per kind are in reference.core.flight, and the
+circle step and vertex windows of the rim vertices in reference.core.rim and window.
+Accelerations `acc` are tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
 
 import math
 
 from .jit import hot
-from .records import Frame, Jet
+from .layout import VX, VY, VZ, WX, WY, WZ, X, Y, Z
+from .records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE, Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
 from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTOR, TINY
+
+
+@hot
+def contact_kind(model, k):
+    """The kind of the ground's contact k (`kind_in_ground` with model.n_rim)."""
+    return kind_in_ground(model.n_rim, k)
+
+
+@hot
+def kind_in_ground(n_rim, k):
+    """The kind of contact k of a ground whose rim vertices come first (n_rim of them)
+    and its floor points after (for loops over contacts, n_rim read once)."""
+    return RIM_VERTEX_ON_PLANE if k < n_rim else FLOOR_POINT_ON_FACE
 
 
 @hot
@@ -40,7 +63,7 @@ def vertex_frame(y, cols, px, py):
     at state y): gap z + r_z, normal e_z, lever r, roundoff GAP_NOISE_ULPS ε (|z| +
     |r_z|)."""
     rx, ry, rz = lever_of_columns(cols, px, py)
-    return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[2], rz))
+    return Frame(y[Z] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[Z], rz))
 
 
 @hot
@@ -55,49 +78,49 @@ def bump_frame(y, bx, by, bz):
     """Frame of the ground bump b under the body's face: gap d·e3 (d = x − b), normal e3,
     lever −d + gap e3, roundoff GAP_NOISE_ULPS ε Σ|d_j e3_j|."""
     ex, ey, ez = body_axis(y)
-    dx, dy, dz = y[0] - bx, y[1] - by, y[2] - bz
+    dx, dy, dz = y[X] - bx, y[Y] - by, y[Z] - bz
     gap = dx * ex + dy * ey + dz * ez
     noise = GAP_NOISE_ULPS * EPS * (abs(dx * ex) + abs(dy * ey) + abs(dz * ez))
     return Frame(gap, ex, ey, ez, -dx + gap * ex, -dy + gap * ey, -dz + gap * ez, noise)
 
 
 @hot
-def contact_frame(y, flat, pts, k):
-    """Gap, normal, lever and gap roundoff of contact k at state y."""
-    if flat:
+def contact_frame(y, kind, pts, k):
+    """Gap, normal, lever and gap roundoff of contact k (of kind `kind`) at state y."""
+    if kind == RIM_VERTEX_ON_PLANE:
         return vertex_frame(y, rotation_columns_xy(y), pts[k, 0], pts[k, 1])
     return bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
 @hot
 def off_face(y, model, pts, k):
-    """Whether contact k meets the face's plane outside its rim, |lever| > a: on the
-    three-point ground a bump beside the body, not under it (the model's contact does
-    not exist there: the body has left the bumps).  Never on flat ground, whose contacts
-    are the vertices themselves."""
-    if model.flat_ground:
+    """Whether contact k has left the model: a floor point meeting the face's plane
+    outside its rim, |lever| > a, beside the body, not under it (the model's contact
+    does not exist there: the body has left the bumps).  Never a rim vertex, a point of
+    the body itself."""
+    if contact_kind(model, k) == RIM_VERTEX_ON_PLANE:
         return False
     f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
     return f.rx * f.rx + f.ry * f.ry + f.rz * f.rz > model.radius * model.radius
 
 
 @hot
-def normal_velocity(y, f, flat):
-    """g′ = n·(v + ω × r) of the contact with frame f (flat ground: v_z + (ω × r)_z)."""
-    wx, wy, wz = y[10], y[11], y[12]
-    if flat:
-        return y[9] + (wx * f.ry - wy * f.rx)
+def normal_velocity(y, f, kind):
+    """g′ = n·(v + ω × r) of the contact with frame f (a rim vertex: v_z + (ω × r)_z)."""
+    wx, wy, wz = y[WX], y[WY], y[WZ]
+    if kind == RIM_VERTEX_ON_PLANE:
+        return y[VZ] + (wx * f.ry - wy * f.rx)
     cx = wy * f.rz - wz * f.ry
     cy = wz * f.rx - wx * f.rz
     cz = wx * f.ry - wy * f.rx
-    return f.nx * (y[7] + cx) + f.ny * (y[8] + cy) + f.nz * (y[9] + cz)
+    return f.nx * (y[VX] + cx) + f.ny * (y[VY] + cy) + f.nz * (y[VZ] + cz)
 
 
 @hot
 def vertex_normal_acceleration(y, f, acc):
     """g″ = v̇_z + (ω̇ × r)_z + (ω × (ω × r))_z of a vertex over flat ground, with
     (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z."""
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     return (
         acc[2]
         + (acc[3] * f.ry - acc[4] * f.rx)
@@ -109,41 +132,42 @@ def vertex_normal_acceleration(y, f, acc):
 @hot
 def bump_normal_acceleration(y, f, acc, bx, by, bz):
     """g″ = n·v̇ + (r × n)·ω̇ + 2 v·(ω × e3) + d·(ω × (ω × e3)) of a bump, d = x − b."""
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     nx, ny, nz = f.nx, f.ny, f.nz
     cx, cy, cz = f.ry * nz - f.rz * ny, f.rz * nx - f.rx * nz, f.rx * ny - f.ry * nx
     lin = nx * acc[0] + ny * acc[1] + nz * acc[2] + cx * acc[3] + cy * acc[4] + cz * acc[5]
     ux, uy, uz = wy * nz - wz * ny, wz * nx - wx * nz, wx * ny - wy * nx  # ω × e3
     vx, vy, vz = wy * uz - wz * uy, wz * ux - wx * uz, wx * uy - wy * ux  # ω × (ω × e3)
-    dx, dy, dz = y[0] - bx, y[1] - by, y[2] - bz
-    return lin + 2.0 * (y[7] * ux + y[8] * uy + y[9] * uz) + dx * vx + dy * vy + dz * vz
+    dx, dy, dz = y[X] - bx, y[Y] - by, y[Z] - bz
+    return lin + 2.0 * (y[VX] * ux + y[VY] * uy + y[VZ] * uz) + dx * vx + dy * vy + dz * vz
 
 
 @hot
-def normal_acceleration(y, f, acc, flat, pts, k):
-    """g″ of contact k (frame f) for accelerations acc."""
-    if flat:
+def normal_acceleration(y, f, acc, kind, pts, k):
+    """g″ of contact k (of kind `kind`, frame f) for accelerations acc."""
+    if kind == RIM_VERTEX_ON_PLANE:
         return vertex_normal_acceleration(y, f, acc)
     return bump_normal_acceleration(y, f, acc, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
 @hot
-def frame_and_rate(y, cols, flat, pts, k):
+def frame_and_rate(y, cols, kind, pts, k):
     """Contact k's frame and normal velocity, without its acceleration (cols: R's
-    first two columns, `rotation.rotation_columns_xy`, used for flat ground)."""
-    if flat:
+    first two columns, `rotation.rotation_columns_xy`, used by a rim vertex)."""
+    if kind == RIM_VERTEX_ON_PLANE:
         f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
-    else:
-        f = contact_frame(y, flat, pts, k)
-    return f, normal_velocity(y, f, flat)
+    else:  # FLOOR_POINT_ON_FACE
+        f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
+    return f, normal_velocity(y, f, kind)
 
 
 @hot
 def point_jet(y, px, py, acc):
-    """Gap, rate, acceleration and roundoff of the body point (px, py, 0) over flat
-    ground."""
+    """Gap, rate, acceleration and roundoff of the body point (px, py, 0) against the
+    plane z = 0 (a rim vertex)."""
     f = vertex_frame(y, rotation_columns_xy(y), px, py)
-    return Jet(f.gap, normal_velocity(y, f, True), vertex_normal_acceleration(y, f, acc), f.noise)
+    rate = normal_velocity(y, f, RIM_VERTEX_ON_PLANE)
+    return Jet(f.gap, rate, vertex_normal_acceleration(y, f, acc), f.noise)
 
 
 @hot
@@ -154,31 +178,32 @@ def rim_jet(y, acc, radius):
     |g″| ≤ |v̇_z| + |r| for every point of the rim."""
     jx = point_jet(y, radius, 0.0, acc)
     jy = point_jet(y, 0.0, radius, acc)
-    z, vz = y[2], y[9]
+    z, vz = y[Z], y[VZ]
     return jx.gap - z, jy.gap - z, jx.rate - vz, jy.rate - vz, jx.accel - acc[2], jy.accel - acc[2]
 
 
 @hot
-def contact_jet(y, flat, pts, k, acc):
-    """Gap, rate, acceleration and gap roundoff of contact k for accelerations acc."""
-    if flat:
+def contact_jet(y, kind, pts, k, acc):
+    """Gap, rate, acceleration and gap roundoff of contact k (of kind `kind`) for
+    accelerations acc."""
+    if kind == RIM_VERTEX_ON_PLANE:
         return point_jet(y, pts[k, 0], pts[k, 1], acc)
-    f = contact_frame(y, flat, pts, k)
-    return Jet(
-        f.gap, normal_velocity(y, f, flat), normal_acceleration(y, f, acc, flat, pts, k), f.noise
-    )
+    bx, by, bz = pts[k, 0], pts[k, 1], pts[k, 2]  # FLOOR_POINT_ON_FACE
+    f = bump_frame(y, bx, by, bz)
+    accel = bump_normal_acceleration(y, f, acc, bx, by, bz)
+    return Jet(f.gap, normal_velocity(y, f, kind), accel, f.noise)
 
 
 @hot
 def speed(y):
     """|v|, the speed of the centre of mass."""
-    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2)
+    return math.sqrt(y[VX] ** 2 + y[VY] ** 2 + y[VZ] ** 2)
 
 
 @hot
 def velocity_scale(y, radius):
     """V = |v| + a|ω|: the largest speed of a rim point (the local velocity unit)."""
-    return speed(y) + radius * math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    return speed(y) + radius * math.sqrt(y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2)
 
 
 @hot
@@ -191,7 +216,7 @@ def rate_noise(y, radius):
 def length_scale(y, radius):
     """L = |z| + a sin α: the height of the centre plus the rim's vertical extent."""
     ex, ey, _ = body_axis(y)
-    return abs(y[2]) + radius * math.sqrt(ex * ex + ey * ey)
+    return abs(y[Z]) + radius * math.sqrt(ex * ex + ey * ey)
 
 
 @hot
@@ -199,9 +224,9 @@ def length_rate(y, radius):
     """U = |ż| + a|ω × e3| ≥ |L′|: how fast L = |z| + a sin α may change (a spin about
     the body's axis leaves it)."""
     ex, ey, ez = body_axis(y)
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     ux, uy, uz = wy * ez - wz * ey, wz * ex - wx * ez, wx * ey - wy * ex
-    return abs(y[9]) + radius * math.sqrt(ux * ux + uy * uy + uz * uz)
+    return abs(y[VZ]) + radius * math.sqrt(ux * ux + uy * uy + uz * uz)
 
 
 @hot

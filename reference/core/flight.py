@@ -13,6 +13,7 @@ import math
 
 from .contacts import speed
 from .jit import hot
+from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .records import Bounds, FlightConstants
 from .rotation import body_axis, qmul, rotation_columns_xy, rotation_vector_quaternion
 from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS, TINY
@@ -22,33 +23,33 @@ from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS, TINY
 def flight_constants(y, i1, i3):
     """L/A, λ, |ω| and Ω of the free flight starting at state y."""
     e3x, e3y, e3z = body_axis(y)
-    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
-    lax = y[10] - w3 * e3x + (i3 / i1) * w3 * e3x
-    lay = y[11] - w3 * e3y + (i3 / i1) * w3 * e3y
-    laz = y[12] - w3 * e3z + (i3 / i1) * w3 * e3z
+    w3 = y[WX] * e3x + y[WY] * e3y + y[WZ] * e3z
+    lax = y[WX] - w3 * e3x + (i3 / i1) * w3 * e3x
+    lay = y[WY] - w3 * e3y + (i3 / i1) * w3 * e3y
+    laz = y[WZ] - w3 * e3z + (i3 / i1) * w3 * e3z
     lam = (1.0 / i3 - 1.0 / i1) * i3 * w3
-    wabs = math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    wabs = math.sqrt(y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2)
     return FlightConstants(lax, lay, laz, lam, wabs, math.sqrt(lax * lax + lay * lay + laz * laz))
 
 
 @hot
 def free_flight(y0, fc, gravity, s, out):
     """The state after a free flight of duration s from y0, into `out` (closed form)."""
-    out[0] = y0[0] + y0[7] * s
-    out[1] = y0[1] + y0[8] * s
-    out[2], out[9] = centre_height(y0[2], y0[9], gravity, s)
-    out[7] = y0[7]
-    out[8] = y0[8]
+    out[X] = y0[X] + y0[VX] * s
+    out[Y] = y0[Y] + y0[VY] * s
+    out[Z], out[VZ] = centre_height(y0[Z], y0[VZ], gravity, s)
+    out[VX] = y0[VX]
+    out[VY] = y0[VY]
     p0, p1, p2, p3 = rotation_vector_quaternion(fc.lax * s, fc.lay * s, fc.laz * s)
-    a = qmul(p0, p1, p2, p3, y0[3], y0[4], y0[5], y0[6])
+    a = qmul(p0, p1, p2, p3, y0[QW], y0[QX], y0[QY], y0[QZ])
     half = 0.5 * fc.lam * s
     b = qmul(a[0], a[1], a[2], a[3], math.cos(half), 0.0, 0.0, math.sin(half))
     nrm = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3])
-    out[3], out[4], out[5], out[6] = b[0] / nrm, b[1] / nrm, b[2] / nrm, b[3] / nrm
+    out[QW], out[QX], out[QY], out[QZ] = b[0] / nrm, b[1] / nrm, b[2] / nrm, b[3] / nrm
     e3x, e3y, e3z = body_axis(out)
-    out[10] = fc.lax + fc.lam * e3x
-    out[11] = fc.lay + fc.lam * e3y
-    out[12] = fc.laz + fc.lam * e3z
+    out[WX] = fc.lax + fc.lam * e3x
+    out[WY] = fc.lay + fc.lam * e3y
+    out[WZ] = fc.laz + fc.lam * e3z
 
 
 @hot
@@ -106,8 +107,9 @@ def _height_terms(fx, fy, fz, Lx, Ly, Lz):
 
 @hot
 def vertex_height_bounds(y0, fc, radius, gravity):
-    """Bounds (K, B) ≥ max over the flight and over every vertex of |g″| and |g‴|, flat
-    ground, and the rim's deepest reach below the centre (`rim_depth_bound`).
+    """Bounds (K, B) ≥ max over the flight and over every rim vertex (contact kind
+    RIM_VERTEX_ON_PLANE) of |g″| and |g‴|, and the rim's deepest reach below the centre
+    (`rim_depth_bound`).
 
     A vertex at body angle θ has height z(s) + a (Rot(L̂, Ωs) w(s))_z with
     w = cos φ f1 + sin φ f2, φ = θ + λs, f1, f2 = R0 ê1, R0 ê2.  With (α_i, β_i, γ_i)
@@ -157,15 +159,16 @@ def rim_depth_bound(y0, Lx, Ly, Lz, radius):
 
 
 @hot
-def bump_gap_bounds(y0, fc, pts, gravity, horizon):
-    """Bounds (K, B; depth inf) for the three-point ground over a flight of `horizon`:
+def bump_gap_bounds(y0, fc, pts, first, gravity, horizon):
+    """Bounds (K, B; depth inf) of the floor points pts[first:] (contact kind
+    FLOOR_POINT_ON_FACE) over a flight of `horizon`:
     with g = (x − b)·e3 and e3 precessing at Ω about L,
         g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴,
     |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2."""
     H = horizon if math.isfinite(horizon) else 1e300
     v0 = speed(y0)
     V = v0 + gravity * H
-    D = _farthest_bump(y0, pts) + v0 * H + 0.5 * gravity * H * H
+    D = _farthest_bump(y0, pts, first) + v0 * H + 0.5 * gravity * H * H
     om = fc.omega
     K = gravity + 2 * V * om + D * om * om
     B = 3 * gravity * om + 3 * V * om * om + D * om**3
@@ -173,26 +176,26 @@ def bump_gap_bounds(y0, fc, pts, gravity, horizon):
 
 
 @hot
-def _farthest_bump(y, pts):
-    """The largest distance from the centre of mass to a bump."""
+def _farthest_bump(y, pts, first):
+    """The largest distance from the centre of mass to a floor point pts[first:]."""
     D = 0.0
-    for k in range(pts.shape[0]):
-        d = math.sqrt((y[0] - pts[k, 0]) ** 2 + (y[1] - pts[k, 1]) ** 2 + (y[2] - pts[k, 2]) ** 2)
+    for k in range(first, pts.shape[0]):
+        d = math.sqrt((y[X] - pts[k, 0]) ** 2 + (y[Y] - pts[k, 1]) ** 2 + (y[Z] - pts[k, 2]) ** 2)
         D = max(D, d)
     return D
 
 
 @hot
 def bound_segment(y, model, pts):
-    """How long a flight from state y is searched with one set of bounds: for ever on
-    flat ground (`vertex_height_bounds` does not depend on it); on the three-point
-    ground max(|v|, √(2 g D))/g, D the farthest bump's distance: over it the speed at
-    most doubles and the distance to a bump at most triples (plus |v|²/2g), so
-    `bump_gap_bounds` stay near their values at its start (without gravity D/|v|: the
-    distance at most doubles)."""
-    if model.flat_ground:
+    """How long a flight from state y is searched with one set of bounds: for ever on a
+    ground of rim vertices alone (`vertex_height_bounds` does not depend on it); with
+    floor points max(|v|, √(2 g D))/g, D the farthest floor point's distance: over it
+    the speed at most doubles and the distance to a floor point at most triples (plus
+    |v|²/2g), so `bump_gap_bounds` stay near their values at its start (without gravity
+    D/|v|: the distance at most doubles)."""
+    if model.n_rim == model.n_contacts:
         return math.inf
-    g, v, D = model.gravity, speed(y), _farthest_bump(y, pts)
+    g, v, D = model.gravity, speed(y), _farthest_bump(y, pts, model.n_rim)
     if g > 0.0:
         return max(v, math.sqrt(2.0 * g * D), TINY) / g
     return D / v if v > 0.0 else math.inf
@@ -200,7 +203,13 @@ def bound_segment(y, model, pts):
 
 @hot
 def flight_bounds(y0, fc, model, pts, horizon):
-    """Bounds for the scene's ground (`vertex_height_bounds` or `bump_gap_bounds`)."""
-    if model.flat_ground:
+    """Bounds for the ground's contacts: `vertex_height_bounds` of its rim vertices,
+    `bump_gap_bounds` of its floor points, the larger K and B of the two when it has
+    both (the rim's depth bound stands: it concerns the rim vertices alone)."""
+    if model.n_rim == model.n_contacts:
         return vertex_height_bounds(y0, fc, model.radius, model.gravity)
-    return bump_gap_bounds(y0, fc, pts, model.gravity, horizon)
+    points = bump_gap_bounds(y0, fc, pts, model.n_rim, model.gravity, horizon)
+    if model.n_rim == 0:
+        return points
+    rim = vertex_height_bounds(y0, fc, model.radius, model.gravity)
+    return Bounds(max(rim.K, points.K), max(rim.B, points.B), rim.depth)

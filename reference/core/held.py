@@ -13,9 +13,10 @@ vertical angular momentum are untouched."""
 
 import numpy as np
 
-from .contacts import contact_frame, normal_acceleration, normal_velocity
+from .contacts import contact_frame, contact_kind, normal_acceleration, normal_velocity
 from .inertia import free_acceleration, impulse_response
 from .jit import hot
+from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .linalg import solve_small
 from .records import SCRATCH
 from .rotation import quaternion_rate, rotate_attitude
@@ -51,14 +52,15 @@ def contact_system(y, model, pts, idx, m, acc, work):
     forces when acc is the free acceleration), work.resp rows = M⁻¹J_iᵀ and w_i, for
     the contacts idx[:m]."""
     for i in range(m):
-        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        kind = contact_kind(model, idx[i])
+        f = contact_frame(y, kind, pts, idx[i])
         rsp = impulse_response(y, f, model.mass, model.i1, model.i3)
         work.resp[i, 0], work.resp[i, 1], work.resp[i, 2] = rsp.dvx, rsp.dvy, rsp.dvz
         work.resp[i, 3], work.resp[i, 4], work.resp[i, 5] = rsp.dwx, rsp.dwy, rsp.dwz
         work.resp[i, 6] = rsp.w
         work.geo[i, 0], work.geo[i, 1], work.geo[i, 2] = f.nx, f.ny, f.nz
         work.geo[i, 3], work.geo[i, 4], work.geo[i, 5] = f.rx, f.ry, f.rz
-        work.b[i] = normal_acceleration(y, f, acc, model.flat_ground, pts, idx[i])
+        work.b[i] = normal_acceleration(y, f, acc, kind, pts, idx[i])
     for i in range(m):
         for j in range(m):
             work.A[i, j] = work.resp[i, 6] if i == j else _row_dot(work.geo, i, work.resp, j)
@@ -104,8 +106,8 @@ def add_responses(start, work, m):
 def held_rhs(y, model, pts, idx, m, work, dy):
     """dy/dt of the held motion into dy (forces in work.lam)."""
     acc = held_acceleration(y, model, pts, idx, m, work)
-    dy[0], dy[1], dy[2] = y[7], y[8], y[9]
-    dy[3], dy[4], dy[5], dy[6] = quaternion_rate(y)
+    dy[X], dy[Y], dy[Z] = y[VX], y[VY], y[VZ]
+    dy[QW], dy[QX], dy[QY], dy[QZ] = quaternion_rate(y)
     for c in range(6):
         dy[7 + c] = acc[c]
 
@@ -119,12 +121,12 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
     acc = free_acceleration(y, model.i1, model.i3, model.gravity)
     contact_system(y, model, pts, idx, m, acc, work)
     for i in range(m):
-        f = contact_frame(y, model.flat_ground, pts, idx[i])
-        work.r[i] = -normal_velocity(y, f, model.flat_ground)
+        kind = contact_kind(model, idx[i])
+        work.r[i] = -normal_velocity(y, contact_frame(y, kind, pts, idx[i]), kind)
     if not solve_small(work.A, work.r, m, work.lam):
         return False
-    y[7], y[8], y[9], y[10], y[11], y[12] = add_responses(
-        (y[7], y[8], y[9], y[10], y[11], y[12]), work, m
+    y[VX], y[VY], y[VZ], y[WX], y[WY], y[WZ] = add_responses(
+        (y[VX], y[VY], y[VZ], y[WX], y[WY], y[WZ]), work, m
     )
     return True
 
@@ -134,7 +136,7 @@ def _gaps_settled(y, model, pts, idx, m, work):
     """work.r = −gaps of contacts idx[:m]; whether each is within its roundoff."""
     settled = True
     for i in range(m):
-        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        f = contact_frame(y, contact_kind(model, idx[i]), pts, idx[i])
         work.r[i] = -f.gap
         if abs(f.gap) > f.noise:
             settled = False
@@ -155,9 +157,9 @@ def project_held(y, model, pts, idx, m, work):
         if not solve_small(work.A, work.r, m, work.lam):
             return False
         dx, dy, dz, px, py, pz = add_responses((0.0, 0.0, 0.0, 0.0, 0.0, 0.0), work, m)
-        y[0] += dx
-        y[1] += dy
-        y[2] += dz
+        y[X] += dx
+        y[Y] += dy
+        y[Z] += dz
         rotate_attitude(y, px, py, pz)
     return zero_normal_velocities(y, model, pts, idx, m, work)
 

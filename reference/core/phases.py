@@ -14,6 +14,7 @@ from .candidates import (
 from .clock import grid_time, time_until, two_sum_add
 from .contacts import (
     contact_frame,
+    contact_kind,
     length_rate,
     length_scale,
     rate_noise,
@@ -35,6 +36,7 @@ from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
 from .jit import copy_into, hot
+from .layout import VX, VY, VZ, WX, WY, WZ
 from .output import push_phase, push_sample
 from .records import (
     EVENT_ACTIVATION,
@@ -283,7 +285,7 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
     is looked at (`vertex_window` with K = δ = 0 is exact: the others are above)."""
     n = pts.shape[0]
     first, count = 0, n
-    if use_window(model, opts.window_search, n):
+    if use_window(model, opts.window_search):
         k0, half = vertex_window(y, model.radius, n, 0.0, 0.0, WINDOW_MAX)
         first, count = k0 - half, min(2 * half + 1, n)
     m = 0
@@ -291,7 +293,7 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
         k = (first + i) % n
         if is_held(state, k):
             continue
-        f = contact_frame(y, model.flat_ground, pts, k)
+        f = contact_frame(y, contact_kind(model, k), pts, k)
         if f.gap < -max(f.noise, gap_res):
             cs.together[m] = k
             m += 1
@@ -325,7 +327,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     for i in range(m):  # the held forces now (ws.lam is reused below)
         ws.lam_chunk[i] = ws.lam[i]
         ws.lam_cur[i] = ws.lam[i]
-    acc = (ws.f[7], ws.f[8], ws.f[9], ws.f[10], ws.f[11], ws.f[12])
+    acc = (ws.f[VX], ws.f[VY], ws.f[VZ], ws.f[WX], ws.f[WY], ws.f[WZ])
     ex = touching_candidates(state, model, pts, opts, acc, cs, gap_res)
     if _touching_event(state, model, pts, opts, stats, out, ws, cs, ex.n, gap_res):
         return DONE

@@ -8,7 +8,9 @@ and pressing into the ground (an activation: it starts to be held).  Contacts wh
 zeros are within their time resolution of the first one's are reached together
 (`collect_together`): the model cannot order them.
 
-Over flat ground, far from it, the circle through the vertices bounds them all at once,
+A ground's rim vertices (contacts 0 … n_rim − 1, kind RIM_VERTEX_ON_PLANE) are searched
+as a family; its other contacts one by one.  Far from the ground, the circle through
+the vertices bounds them all at once,
 for any n (reference.core.rim: a step from the rim's jet, then its lowest point followed
 in closed form down to two sags above the ground).  Nearer, large polygons (n > SMALL_N)
 examine only the vertices that can touch within the step: a vertex's gap, rate and
@@ -21,7 +23,9 @@ import math
 
 from .contacts import (
     contact_jet,
+    contact_kind,
     frame_and_rate,
+    kind_in_ground,
     normal_acceleration,
     rate_noise,
     reached_together,
@@ -30,7 +34,17 @@ from .contacts import (
 )
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
-from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent, Jet
+from .layout import VZ, Z
+from .records import (
+    EVENT_ACTIVATION,
+    EVENT_IMPACT,
+    EVENT_NONE,
+    EVENT_STUCK,
+    FLOOR_POINT_ON_FACE,
+    RIM_VERTEX_ON_PLANE,
+    FlightEvent,
+    Jet,
+)
 from .rim import circle_step, far_from_ground, lands_near, rim_descent, rim_step
 from .roots import (
     p2_positive_at,
@@ -65,17 +79,17 @@ def _safe_side_gap(gap, noise):
 
 
 @hot
-def examine(y, acc, cols, flat, pts, k, K, B, vnoise, res):
+def examine(y, acc, cols, kind, pts, k, K, B, vnoise, res):
     """Examine contact k at state y (cols: R's first two columns, formed once for all
     the contacts of a step): update res with its safe step, or record it as hit
     (touching and approaching faster than a graze) or landing (touching at rest,
     accelerating into the ground).  A contact clear of the ground whose P2 is still
     positive at the step found so far does not bind it (`roots.safe_step` would return
     that step): passed over before its acceleration is formed."""
-    f, rate = frame_and_rate(y, cols, flat, pts, k)
+    f, rate = frame_and_rate(y, cols, kind, pts, k)
     if f.gap > f.noise and p2_positive_at(f.gap, rate, K, res[STEP]):
         return
-    j = Jet(f.gap, rate, normal_acceleration(y, f, acc, flat, pts, k), f.noise)
+    j = Jet(f.gap, rate, normal_acceleration(y, f, acc, kind, pts, k), f.noise)
     g = j.gap
     if g <= j.noise:
         graze = GRAZE_FACTOR * math.sqrt(2.0 * max(j.accel, 0.0) * j.noise)
@@ -111,8 +125,8 @@ def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
     best = k = first % n
     for _ in range(count):
         cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
-        g = max(y[2] + cx * px + cy * py, TINY)
-        g1 = y[9] + cx * qx + cy * qy
+        g = max(y[Z] + cx * px + cy * py, TINY)
+        g1 = y[VZ] + cx * qx + cy * qy
         if not p2_positive_at(g, g1, K, best_d):  # (else it cannot come first)
             d = quadratic_first_root(g, g1, K)
             if d < best_d:
@@ -130,11 +144,11 @@ def examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius):
         return
     cols = rotation_columns_xy(y)
     lead = likely_binding(y, jet, pts, n, K, first, count, radius, res[STEP])
-    examine(y, acc, cols, True, pts, lead, K, B, vnoise, res)
+    examine(y, acc, cols, RIM_VERTEX_ON_PLANE, pts, lead, K, B, vnoise, res)
     k = first % n
     for _ in range(count):
         if k != lead:
-            examine(y, acc, cols, True, pts, k, K, B, vnoise, res)
+            examine(y, acc, cols, RIM_VERTEX_ON_PLANE, pts, k, K, B, vnoise, res)
         k = next_index(k, n)
 
 
@@ -169,11 +183,13 @@ def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise
 
 @hot
 def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
-    """One iteration's certified step (res holds hits and landings): every contact for
-    small n or the three-point ground, else, far from the ground, the circle through the
-    vertices (its step from the rim's jet, then `rim.rim_descent`), or the vertices near
-    the lowest direction.  Returns (step, last certified window step)."""
-    n = pts.shape[0]
+    """One iteration's certified step (res holds hits and landings): the ground's
+    contacts other than rim vertices one by one (every contact of a ground without rim
+    vertices), then its rim vertices as a family: far from the ground, the circle
+    through them (its step from the rim's jet, then `rim.rim_descent`), else every
+    vertex for small n, or the vertices near the lowest direction; the shorter step of
+    the two kept (`_shorter`).  Returns (step, last certified window step)."""
+    n, n_rim = pts.shape[0], model.n_rim
     K, B = bounds.K, bounds.B
     res[STEP], res[STEP_K], res[HIT_DS], res[HIT_K], res[LAND_K] = (
         math.inf,
@@ -182,25 +198,43 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
         -1.0,
         -1.0,
     )
-    if not model.flat_ground:
-        cols = rotation_columns_xy(y)  # (unused by the bumps' frames)
-        for k in range(n):
-            examine(y, acc, cols, False, pts, k, K, B, vnoise, res)
-        return res[STEP], last_dlt
+    other, other_k = math.inf, -1.0
+    if n_rim < n:
+        cols = rotation_columns_xy(y)  # (unused by a floor point's frame)
+        for k in range(n_rim, n):  # the floor points (`contacts.kind_in_ground`)
+            examine(y, acc, cols, FLOOR_POINT_ON_FACE, pts, k, K, B, vnoise, res)
+        if n_rim == 0:
+            return res[STEP], last_dlt
+        other, other_k = res[STEP], res[STEP_K]
+        res[STEP], res[STEP_K] = math.inf, -1.0
     jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
     rim = rim_step(y, model.gravity, bounds.depth, model.radius)
     if far_from_ground(y, jet, model):
         d_c = max(circle_step(y, jet, model.gravity, B), rim)
-        if lands_near(jet, B, d_c, model):
-            return d_c, last_dlt
-        return rim_descent(y, fc, model, bounds.depth, left, d_c), last_dlt
+        if not lands_near(jet, B, d_c, model):
+            d_c = rim_descent(y, fc, model, bounds.depth, left, d_c)
+        return _shorter(d_c, other, other_k, res), last_dlt
     if not windowed:
-        examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
-        return max(res[STEP], rim), last_dlt
-    cap = near_vertices_step(y, acc, jet, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
+        examine_range(y, acc, jet, pts, n_rim, K, B, 0, n_rim, vnoise, res, model.radius)
+        return _shorter(max(res[STEP], rim), other, other_k, res), last_dlt
+    cap = near_vertices_step(
+        y, acc, jet, pts, model.radius, n_rim, K, B, left, last_dlt, vnoise, res
+    )
     if cap < math.inf:
         last_dlt = cap
-    return max(min(res[STEP], cap), rim), last_dlt
+    return _shorter(max(min(res[STEP], cap), rim), other, other_k, res), last_dlt
+
+
+@hot
+def _shorter(step, other, other_k, res):
+    """The shorter of the rim vertices' step and the other contacts' (`other`, set by
+    contact other_k; inf when the ground has none), res[STEP] and res[STEP_K] those of
+    the other contact when it sets it (the rim's step may exceed its examined vertices'
+    by `rim.rim_step`, which bounds the rim vertices alone)."""
+    if other < step:
+        res[STEP], res[STEP_K] = other, other_k
+        return other
+    return step
 
 
 @hot
@@ -218,14 +252,15 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
     t = end
-    flat = model.flat_ground
+    n_rim = model.n_rim
     cols = rotation_columns_xy(y)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, j = next_index(nxt, n), nxt
         if j == k:
             continue
-        f, rate = frame_and_rate(y, cols, flat, pts, j)
+        kind = kind_in_ground(n_rim, j)
+        f, rate = frame_and_rate(y, cols, kind, pts, j)
         g = f.gap
         if g <= f.noise:
             if not rate > vnoise:
@@ -233,14 +268,14 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
             g = _safe_side_gap(g, f.noise)
         if p2_positive_at(g, rate, K, t):
             continue  # safe_step would return t: its acceleration is not needed
-        t = min(t, safe_step(g, rate, normal_acceleration(y, f, acc, flat, pts, j), K, B, t))
+        t = min(t, safe_step(g, rate, normal_acceleration(y, f, acc, kind, pts, j), K, B, t))
         if not t > floor:
             return t
     return t
 
 
 @hot
-def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, x, y):
+def _newton_in_bracket(y0, fc, gravity, kind, pts, k, lo, hi, x, y):
     """Contact k's single zero in [lo, hi] (gap > 0 at lo, ≤ 0 at hi, decreasing):
     Newton steps from x in the bracket kept strictly inside the shrinking bracket
     (bisection otherwise), until
@@ -251,7 +286,7 @@ def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, x, y):
     6 ulps apart, the cap), so a step onto a bracket end bisects instead."""
     for _ in range(BRACKET_ITERATIONS):
         free_flight(y0, fc, gravity, x, y)
-        j = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, gravity))
+        j = contact_jet(y, kind, pts, k, flight_acceleration(fc, y, gravity))
         if j.gap > 0.0:
             lo = x
         else:
@@ -276,8 +311,8 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     returns its time with y there (the impact test of `examine` holds there), or −1
     when the shortcut does not apply (y then undefined)."""
     k = int(res[STEP_K])
-    flat = model.flat_ground
-    j = contact_jet(y, flat, pts, k, acc)
+    kind = contact_kind(model, k)
+    j = contact_jet(y, kind, pts, k, acc)
     if j.gap <= j.noise:
         return -1.0
     K, B = bounds.K, bounds.B
@@ -295,10 +330,10 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     x0 = min(max(taylor, step), end)
     if (x0 - step) * abs(j.rate) <= j.noise:
         x0 = step
-    x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, s + x0, y)
+    x = _newton_in_bracket(y0, fc, model.gravity, kind, pts, k, s + step, s + end, s + x0, y)
     if safe < end and x - s > safe:
         return -1.0
-    jr = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, model.gravity))
+    jr = contact_jet(y, kind, pts, k, flight_acceleration(fc, y, model.gravity))
     graze = GRAZE_FACTOR * math.sqrt(2.0 * max(jr.accel, 0.0) * jr.noise)
     if jr.gap <= jr.noise and jr.rate < -max(vnoise, graze):
         return x
@@ -306,13 +341,13 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
 
 
 @hot
-def polish_impact(y0, fc, gravity, flat, pts, k, s_hit, y):
+def polish_impact(y0, fc, gravity, kind, pts, k, s_hit, y):
     """Newton steps on contact k's gap from s_hit; y ends at the polished time, which is
     returned."""
     free_flight(y0, fc, gravity, s_hit, y)
     for _ in range(POLISH_ITERATIONS):
         acc = flight_acceleration(fc, y, gravity)
-        j = contact_jet(y, flat, pts, k, acc)
+        j = contact_jet(y, kind, pts, k, acc)
         corr = -j.gap / j.rate
         if not math.isfinite(corr) or abs(corr) <= POLISH_REL_TOL * max(abs(s_hit), TINY):
             break
@@ -335,20 +370,19 @@ def _candidates(y, model, pts, bounds, windowed):
 def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
     """Contacts reached with k0 at state y (k0 first): approaching, with a zero within
     SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
-    flat = model.flat_ground
     cols = rotation_columns_xy(y)
-    f0, rate0 = frame_and_rate(y, cols, flat, pts, k0)
+    f0, rate0 = frame_and_rate(y, cols, contact_kind(model, k0), pts, k0)
     tres0 = time_resolution(f0.noise, rate0)
     together[0] = k0
     count = 1
-    n = pts.shape[0]
+    n, n_rim = pts.shape[0], model.n_rim
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
         if k == k0:
             continue
-        f, rate = frame_and_rate(y, cols, flat, pts, k)
+        f, rate = frame_and_rate(y, cols, kind_in_ground(n_rim, k), pts, k)
         if rate >= -vnoise:
             continue
         if reached_together(f.gap, rate, f.noise, tres0):
@@ -361,12 +395,12 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
 def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     """Contacts touching at rest and accelerating into the ground at state y."""
     count = 0
-    n = pts.shape[0]
+    n, n_rim = pts.shape[0], model.n_rim
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
-        j = contact_jet(y, model.flat_ground, pts, k, acc)
+        j = contact_jet(y, kind_in_ground(n_rim, k), pts, k, acc)
         if j.gap <= j.noise and j.rate <= vnoise and j.accel < 0:
             together[count] = k
             count += 1
@@ -377,7 +411,7 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
 def flight_event(y0, fc, model, pts, window_search, horizon, max_iter, y, together, res):
     """The first event of the free flight from y0 within `horizon`, searched segment by
     segment: each with the bounds (`flight.flight_bounds`) of its own length from the
-    state at its start (`flight.bound_segment`: the whole horizon on flat ground, whose
+    state at its start (`flight.bound_segment`: the whole horizon on a ground of rim vertices, whose
     bounds hold for ever; on the three-point ground bounds over the whole horizon would
     grow with its square and cube).  FlightEvent as `find_flight_event`, its iterations
     summed over the segments."""
@@ -404,9 +438,8 @@ def find_flight_event(
     there; y holds the state at s_start on entry): FlightEvent with y at its time (at
     the horizon when there is none) and the contacts reached in together[:n_together]
     (res: 5 floats of scratch)."""
-    n = pts.shape[0]
     g = model.gravity
-    windowed = use_window(model, window_search, n)
+    windowed = use_window(model, window_search)
     s = s_start
     vnoise = rate_noise(y0, model.radius)  # of the flight's state: |ω| is constant
     last_dlt = math.inf
@@ -417,7 +450,8 @@ def find_flight_event(
         )
         if res[HIT_K] >= 0:
             k = int(res[HIT_K])
-            s = polish_impact(y0, fc, g, model.flat_ground, pts, k, s + res[HIT_DS], y)
+            kind = contact_kind(model, k)
+            s = polish_impact(y0, fc, g, kind, pts, k, s + res[HIT_DS], y)
             m = collect_together(y, model, pts, bounds, windowed, k, vnoise, together)
             return FlightEvent(EVENT_IMPACT, s, k, m, it)
         if res[LAND_K] >= 0:
