@@ -61,6 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reference.core import layout as L
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
@@ -365,7 +366,8 @@ def from_drake_state(x: np.ndarray) -> np.ndarray:
     contact geometry use q/|q| (math::RotationMatrix normalises a quaternion):
     `quaternion_norm_drift` below records the drift."""
     y = np.array(x, dtype=float)[..., _FROM_DRAKE]
-    y[..., 3:7] /= np.linalg.norm(y[..., 3:7], axis=-1, keepdims=True)
+    q = y[..., L.QUATERNION]
+    y[..., L.QUATERNION] = q / np.linalg.norm(q, axis=-1, keepdims=True)
     return y
 
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from reference import ReferenceOptions, Scene, Trajectory, simulate
 from reference import quaternion as qt
+from reference.core import layout as L
 from reference.geometry import initial_state, scene_contact_kinematics
 from reference.scene import InitialState, RunSettings, velocity_unit
 
@@ -32,11 +33,11 @@ def units(scene: Scene) -> np.ndarray:
 def difference(scene: Scene, y: np.ndarray, y_ref: np.ndarray) -> np.ndarray:
     """(..., 12) the dimensionless difference y − y_ref of states (..., 13)."""
     y, y_ref = np.asarray(y, dtype=float), np.asarray(y_ref, dtype=float)
-    rel = qt.multiply(y[..., 3:7], qt.conjugate(y_ref[..., 3:7]))
+    rel = qt.multiply(y[..., L.QUATERNION], qt.conjugate(y_ref[..., L.QUATERNION]))
     phi = qt.to_rotation_vector(rel)
-    d = np.concatenate(
-        [y[..., 0:3] - y_ref[..., 0:3], phi, y[..., 7:13] - y_ref[..., 7:13]], axis=-1
-    )
+    dx = y[..., L.POSITION] - y_ref[..., L.POSITION]
+    dv = y[..., L.VELOCITIES] - y_ref[..., L.VELOCITIES]
+    d = np.concatenate([dx, phi, dv], axis=-1)
     return d / units(scene)
 
 
@@ -59,9 +60,10 @@ def displaced(scene: Scene, y: np.ndarray, step: np.ndarray) -> np.ndarray:
     frame), so that `difference(scene, displaced(y, s), y) = s` to roundoff."""
     s = np.asarray(step, dtype=float) * units(scene)
     out = np.array(y, dtype=float)
-    out[0:3] += s[0:3]
-    out[3:7] = qt.normalize(qt.multiply(qt.from_rotation_vector(s[3:6]), out[3:7]))
-    out[7:13] += s[6:12]
+    out[L.POSITION] += s[0:3]  # s: (position, rotation vector, velocities), units()
+    turn = qt.from_rotation_vector(s[3:6])
+    out[L.QUATERNION] = qt.normalize(qt.multiply(turn, out[L.QUATERNION]))
+    out[L.VELOCITIES] += s[6:12]
     return out
 
 
@@ -72,15 +74,18 @@ def lifted(scene: Scene, y: np.ndarray) -> tuple[np.ndarray, float]:
     bump's gap (x − b_k)·e3 grows by the same amount).  Velocities are unchanged: this
     is the position projection a fixed-step engine makes after a step that ends inside
     the ground, and it changes the potential energy by m g times the depth."""
+    from reference.core.records import RIM_VERTEX_ON_PLANE
+
     gap, _ = scene_contact_kinematics(scene, y)
-    depth = float(max(0.0, -np.min(gap)))
+    deepest = int(np.argmin(gap))
+    depth = float(max(0.0, -gap.flat[deepest]))
     if depth == 0.0:
         return np.array(y, dtype=float), 0.0
     out = np.array(y, dtype=float)
     normal = np.array([0.0, 0.0, 1.0])
-    if scene.ground.kind != "flat":
-        normal = qt.body_axis(out[3:7])
-    out[0:3] += depth * normal
+    if scene.contacts.kind(deepest) != RIM_VERTEX_ON_PLANE:
+        normal = qt.body_axis(out[L.QUATERNION])
+    out[L.POSITION] += depth * normal
     return out, depth
 
 
@@ -102,10 +107,10 @@ def scene_at(scene: Scene, y: np.ndarray, t_end: float, max_impacts: int) -> Sce
     scene-file checks: the caller has lifted y onto the ground)."""
     y = np.asarray(y, dtype=float)
     initial = InitialState(
-        position=tuple(float(x) for x in y[0:3]),
-        rotation_vector=tuple(float(x) for x in qt.to_rotation_vector(y[3:7])),
-        velocity=tuple(float(x) for x in y[7:10]),
-        angular_velocity=tuple(float(x) for x in y[10:13]),
+        position=tuple(float(x) for x in y[L.POSITION]),
+        rotation_vector=tuple(float(x) for x in qt.to_rotation_vector(y[L.QUATERNION])),
+        velocity=tuple(float(x) for x in y[L.VELOCITY]),
+        angular_velocity=tuple(float(x) for x in y[L.ANGULAR_VELOCITY]),
     )
     return replace(scene, initial=initial, run=RunSettings(t_end, max_impacts))
 

@@ -113,6 +113,14 @@ def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
     )
 
 
+def contact_word(scene: Scene) -> str:
+    """What the raster's y axis counts: vertices, bumps, or contacts of both kinds."""
+    contacts = scene.contacts
+    if contacts.rim_only:
+        return "vertex"
+    return "contact" if contacts.has_plane else "bump"
+
+
 def _write(
     runs: list[RunView],
     scene: Scene,
@@ -135,7 +143,7 @@ def _write(
         None if e_plot is None else e_plot.axes,
         None if a_plot is None else a_plot.axes,
         focus_range(ref.trajectory.impact_times(), t_max),
-        "bump" if scene.ground.kind == "three_point" else "vertex",
+        contact_word(scene),
     )
     rec = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     if not rr.is_enabled(rec):

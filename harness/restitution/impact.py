@@ -65,6 +65,20 @@ class ImpactReading:
         return asdict(self)
 
 
+def watched_contact(points: np.ndarray, flat: bool):
+    """The watched point as a one-contact ground (reference.contact_kinds): a rim point
+    on the plane when `flat`, else a floor point under the face."""
+    from reference.contact_kinds import GroundContacts
+
+    return GroundContacts(np.ascontiguousarray(points, dtype=float), 1 if flat else 0)
+
+
+def _kind(flat: bool) -> int:
+    from reference.core.records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE
+
+    return RIM_VERTEX_ON_PLANE if flat else FLOOR_POINT_ON_FACE
+
+
 def contact_compliance(scene: Scene, state: np.ndarray, points: np.ndarray, flat: bool) -> float:
     """w = J M⁻¹ Jᵀ of the contact at points[0] in `state`: the reference's own
     `impulse_response` (the normal velocity's change per unit normal impulse)."""
@@ -73,7 +87,7 @@ def contact_compliance(scene: Scene, state: np.ndarray, points: np.ndarray, flat
 
     i1, _, i3 = scene.body.inertia_diag
     y = np.ascontiguousarray(state, dtype=float)
-    frame = contact_frame(y, flat, np.ascontiguousarray(points, dtype=float), 0)
+    frame = contact_frame(y, _kind(flat), np.ascontiguousarray(points, dtype=float), 0)
     return float(impulse_response(y, frame, scene.body.mass, i1, i3).w)
 
 
@@ -89,7 +103,8 @@ def free_normal_acceleration(
     y = np.ascontiguousarray(state, dtype=float)
     pts = np.ascontiguousarray(points, dtype=float)
     acc = free_acceleration(y, i1, i3, scene.gravity)
-    return float(normal_acceleration(y, contact_frame(y, flat, pts, 0), acc, flat, pts, 0))
+    kind = _kind(flat)
+    return float(normal_acceleration(y, contact_frame(y, kind, pts, 0), acc, kind, pts, 0))
 
 
 def exact_energy_loss(gamma: float, u_pre: float, w: float) -> float:
@@ -102,7 +117,7 @@ def read_impact(scene: Scene, traj: Trajectory, points: np.ndarray, flat: bool) 
     states = trajectory_states(traj)
     if len(states) < 2:
         return ImpactReading(_ended(traj))
-    gap, un = (c[:, 0] for c in contact_kinematics(states, points, flat))
+    gap, un = (c[:, 0] for c in contact_kinematics(states, watched_contact(points, flat)))
     entry = _first(np.flatnonzero((gap[1:] < 0.0) | (un[1:] > 0.0)) + 1)
     if entry is None:
         return ImpactReading("no contact" if traj.status.value == "t_end" else _ended(traj))

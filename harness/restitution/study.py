@@ -113,8 +113,10 @@ def _resting(traj, points, flat, u_pre) -> bool:
     """The watched point no longer moves (its last RESTING_ROWS rows)."""
     from reference.geometry import contact_kinematics
 
+    from .impact import watched_contact
+
     states = trajectory_states(traj)[-RESTING_ROWS:]
-    un = contact_kinematics(states, points, flat)[1][:, 0]
+    un = contact_kinematics(states, watched_contact(points, flat))[1][:, 0]
     return bool(np.max(np.abs(un)) < RESTING * abs(u_pre))
 
 
