@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import compiled
+from . import compiled, continuation
 from .core import records as R
 from .core.records import (
     N_ACCUMULATIONS,
@@ -30,7 +30,7 @@ from .core.records import (
 from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
-from .scene import Scene
+from .scene import Scene, check_impact_law, check_window
 from .stats import RunStats
 from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
 
@@ -211,14 +211,38 @@ def simulate(
     (every `options.work_budget` steps).  stats.wall_time_s is the run alone;
     stats.compile_s the one-time compilation or loading that preceded it."""
     opts = options or ReferenceOptions()
+    law, window = impact_law_of(scene, opts)
     compile_s = compiled.warm_up()
     t_end = float(t_end if t_end is not None else scene.run.t_end)
     problem = make_problem(scene, t_end, opts)
     kernel = compiled.run_events()
     t0 = time.perf_counter()
     run_problem(kernel, problem, opts.max_samples, progress)
+    note = None
+    if law != "paper" and continuation.undecidable(problem.state[0]):
+        note = continuation.continue_run(
+            scene, problem, kernel, law, opts.sequential_order, opts.energy_floor,
+            lambda k, p: run_problem(k, p, opts.max_samples, progress),
+        )  # fmt: skip
+        problem.options["energy_floor"] = opts.energy_floor  # (restarts rescale it)
     wall = time.perf_counter() - t0
-    return _trajectory(scene, problem, opts, t_end, wall, compile_s)
+    traj = _trajectory(scene, problem, opts, t_end, wall, compile_s)
+    traj.impact_law, traj.simultaneity_window = law, window
+    if note is not None:
+        traj.message = note
+    return traj
+
+
+def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
+    """The impact law and simultaneity window of a run: the options' if set, else the
+    scene's."""
+    law = opts.impact_law if opts.impact_law is not None else scene.impact_law
+    window = (
+        opts.simultaneity_window
+        if opts.simultaneity_window is not None
+        else scene.simultaneity_window
+    )
+    return check_impact_law(law), check_window(window)
 
 
 def tiny_run(kernel) -> None:

@@ -23,6 +23,7 @@ from ..outputs import OutputError
 from . import (
     analyze,
     bench,
+    branches,
     compare,
     engines,
     fidelity,
@@ -40,6 +41,7 @@ COMMANDS = (
     engines,
     simulate,
     compare,
+    branches,
     bench,
     stress,
     fidelity,

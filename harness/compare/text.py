@@ -12,7 +12,7 @@ from reference.scene import Scene
 from reference.trajectory import Status
 
 from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
-from ..text import table
+from ..text import impact_law_text, table
 
 if TYPE_CHECKING:
     from . import CompareResult, EngineRun
@@ -144,7 +144,8 @@ def _header(result: CompareResult) -> list[str]:
     shape = "rod" if body.n == 2 else f"{body.n}-gon"
     head = (
         f"{scene.name}: {shape} on {scene.ground.kind.replace('_', '-')} ground, "
-        f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}"
+        f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}, "
+        f"impact law {impact_law_text(ref.impact_law or 'paper', ref.simultaneity_window)}"
     )
     text = (
         f"reference: {ref.status.value} at t = {ref.t_final:.7g} s after {len(ref.impacts)} "

@@ -66,8 +66,11 @@ def config_from_args(args) -> SweepConfig:
         engine=args.engine,
         dt=float(dt) if (dt is not None and is_fixed_step(args.engine)) else None,
         min_decades=default_min_decades(args.engine),
+        impact_law=getattr(args, "impact_law", None) or "paper",
         **extra,
     )
+    if getattr(args, "simultaneity_window", None):
+        raise _bad("--simultaneity-window > 0 is not supported by this build's core yet")
     check_config(config)
     return config
 
@@ -269,6 +272,7 @@ def summarise(config, df, store, statuses_now, n_before, n_missing, duplicates) 
     return {
         "command": "sweep exponent",
         "engine": config.engine,
+        "impact_law": config.impact_law,
         "n": config.n,
         "out": str(store.root),
         "dir": str(store.dir),

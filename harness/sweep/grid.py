@@ -47,9 +47,12 @@ class SweepConfig:
     max_impacts: int = 20000
     t_end: float = 200.0
     min_decades: float = 6.0
+    impact_law: str = "paper"  # the reference's law of simultaneous impacts
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        if d["impact_law"] == "paper":  # manifests written before the key stay valid
+            del d["impact_law"]
         d["gyration"] = list(self.gyration)
         d["restitution"] = list(self.restitution)
         d["version"] = MANIFEST_VERSION
