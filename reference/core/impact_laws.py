@@ -22,11 +22,11 @@ Laws (`LAW_*`; their names in `LAW_NAMES`):
   is ½|GᵀΛ|² + qᵀΛ, constant on the convex set of minimisers, so GᵀΛ and WΛ are the
   same for every solution.  Λ is unique only when W is definite; with more than three
   contacts on the flat face (W of rank 3) we choose the **least-norm impulses**: the
-  limit of the Tikhonov-regularised problem W + εI as ε → 0.  It is solved by Murty's
-  least-index principal pivoting on W + εI (finite for a positive definite matrix),
-  then iterated Tikhonov on the active set found (each pass solves (W_AA + εI)δ =
-  r, r the residual of W_AA Λ_A = −q_A), which removes the O(ε) error along W's range
-  and leaves Λ's null-space part at the least-norm one to O(ε) relative.  With one
+  limit of the Tikhonov-regularised problem W + εI as ε → 0.  The active set A comes
+  from Murty's least-index principal pivoting on W + εI (finite for a positive
+  definite matrix), then Λ_A is the minimum-norm solution of W_AA Λ_A = −q_A by
+  iterated Tikhonov from 0 (`_refine`: exact along W's range, ~1e-12 relative along
+  its null space).  With one
   contact the law is eq. F exactly (`single_impulse`).  Across the impact
   ΔT = ½Λᵀ(u⁻ + u⁺) = ½ Σ Λᵢ(1 − γ) u⁻ᵢ ≤ 0 when every touching contact approaches or
   rests.
@@ -56,12 +56,19 @@ LAW_NAMES = ("paper", "moreau", "sequential")
 SETTLED = 0
 NOT_SETTLED = 1  # sequential: MAX_SEQUENTIAL_IMPACTS reached; moreau: pivot cap
 SINGULAR = 2  # a contact whose W_ii is not positive (no impulse can move it)
+TOO_MANY = 3  # more than MAX_LAW_CONTACTS contacts
 
 # Tikhonov weight ε = REGULARISATION × max Wᵢᵢ: the regularised matrix has condition
 # ≤ 1e8, so its solve is good to ~1e-8 relative along W's near-null directions (the
 # impulses' non-unique part) and the refinement makes u⁺ exact to roundoff.
 REGULARISATION = 1e-8
-REFINE_PASSES = 6
+# the refinement's regularisation, and its cap on passes (near-singular definite W, e.g.
+# two adjacent vertices of a 1000-gon, λ ≈ 4e-5 max Wᵢᵢ, converge by ~0.7 per pass)
+REFINE_REGULARISATION = 1e-4
+MAX_REFINE_PASSES = 400
+# the laws take at most this many contacts (Moreau's pivoting costs O(k⁴) at worst): a
+# larger polygon landing flat ends the run undecidable, saying so
+MAX_LAW_CONTACTS = 64
 # complementarity tolerance of the pivoting, relative to the largest |qᵢ| (roundoff)
 PIVOT_TOL = 64.0 * 2.220446049250313e-16
 # the sequential law has settled when no contact approaches faster than this × max|u⁻|:
@@ -114,6 +121,13 @@ def _cholesky_solve(W, eps, active, k, chol, rhs, out):
     m = _cholesky(W, eps, active, k, chol)
     if m < 0:
         return False
+    _solve_factored(active, k, chol, m, rhs, out)
+    return True
+
+
+@hot
+def _solve_factored(active, k, chol, m, rhs, out):
+    """out[A] = (L Lᵀ)⁻¹ rhs[A] with L = chol[:m, :m] (`_cholesky`); 0 elsewhere."""
     for i in range(k):
         out[i] = 0.0
     r = 0  # forward: L y = rhs_A (y kept in out at the active positions)
@@ -138,7 +152,6 @@ def _cholesky_solve(W, eps, active, k, chol, rhs, out):
                     c -= 1
             out[i] = s / chol[r, r]
             r -= 1
-    return True
 
 
 @hot
@@ -174,6 +187,8 @@ def moreau_impulses(W, u_pre, gamma, k, lam, u_post, chol, vec, active):
     the last iterate) or SINGULAR (a Wᵢᵢ ≤ 0)."""
     if k == 0:
         return SETTLED
+    if k > MAX_LAW_CONTACTS:
+        return TOO_MANY
     wmax = 0.0
     for i in range(k):
         if not W[i, i] > 0.0:
@@ -210,7 +225,7 @@ def moreau_impulses(W, u_pre, gamma, k, lam, u_post, chol, vec, active):
             status = SETTLED
             break
         active[flip] = 1 - active[flip]
-    _refine(W, eps, q, k, lam, u_post, chol, r, active)
+    _refine(W, wmax, q, k, lam, u_post, chol, r, active)
     for i in range(k):
         lam[i] = max(lam[i], 0.0)
     post_velocities(W, u_pre, lam, k, u_post)
@@ -218,16 +233,29 @@ def moreau_impulses(W, u_pre, gamma, k, lam, u_post, chol, vec, active):
 
 
 @hot
-def _refine(W, eps, q, k, lam, scratch, chol, r, active):
-    """Iterated Tikhonov on the active set: Λ_A += (W_AA + εI)⁻¹(−q_A − W_AA Λ_A), so
-    that W_AA Λ_A = −q_A to roundoff (each pass shrinks the residual along an
-    eigenvector of eigenvalue λ by ε/(λ + ε))."""
-    for _ in range(REFINE_PASSES):
+def _refine(W, wmax, q, k, lam, scratch, chol, r, active):
+    """Λ_A = the minimum-norm solution of W_AA Λ_A = −q_A, by iterated Tikhonov from 0
+    with ε₂ = REFINE_REGULARISATION × max Wᵢᵢ: Λ_A += (W_AA + ε₂I)⁻¹(−q_A − W_AA Λ_A).
+    Every iterate lies in W_AA's range (so the limit is the least-norm solution); each
+    pass shrinks the residual along an eigenvector of eigenvalue λ by ε₂/(λ + ε₂); the
+    passes stop once it no longer shrinks (roundoff), at most MAX_REFINE_PASSES.  The
+    moderate ε₂ keeps the roundoff of the solves along W's null space at ~1e-12."""
+    m = _cholesky(W, REFINE_REGULARISATION * wmax, active, k, chol)
+    if m < 0:
+        return
+    for i in range(k):
+        lam[i] = 0.0
+    last = math.inf
+    for _ in range(MAX_REFINE_PASSES):
         post_velocities(W, q, lam, k, scratch)
+        size = 0.0
         for i in range(k):
             r[i] = -scratch[i] if active[i] else 0.0
-        if not _cholesky_solve(W, eps, active, k, chol, r, scratch):
-            return
+            size = max(size, abs(r[i]))
+        if not size < last:
+            break
+        last = size
+        _solve_factored(active, k, chol, m, r, scratch)
         for i in range(k):
             lam[i] += scratch[i]
 
@@ -239,6 +267,8 @@ def sequential_impulses(W, u_pre, gamma, k, order, n_order, lam, u_post, max_hit
     sweeps over order[:n_order]; at most max_hits of them (MAX_SEQUENTIAL_IMPACTS).
     lam[:k] sums each contact's impulses; u_post[:k] the normal velocities after.
     Returns (status, number of single impacts)."""
+    if k > MAX_LAW_CONTACTS:
+        return TOO_MANY, 0
     umax = 0.0
     for i in range(k):
         if not W[i, i] > 0.0:
