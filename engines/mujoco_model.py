@@ -28,8 +28,6 @@ import mujoco
 
 from reference.scene import Scene
 
-from .base import scene_points
-
 PROFILES = ("tuned", "default")
 # intprm[0] of a contact sensor: the bit set of its data fields; 2 = "force" (the MJCF
 # attribute data="force" compiles to it, read back from MjSpec.from_string).
@@ -181,11 +179,12 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> ContactSettings:
 
 
 def contact_geom_pairs(scene: Scene) -> list[tuple[str, str]]:
-    """(geom1, geom2) names of contact k: vertex k/ground on flat, bump k/face on
-    three_point (the contact numbering of docs/contract.md)."""
-    if scene.ground.kind == "three_point":
-        return [(f"bump{k}", "face") for k in range(3)]
-    return [(f"vertex{k}", "ground") for k in range(scene.body.n)]
+    """(geom1, geom2) names of contact k: vertex k/ground for a rim vertex, bump j/face
+    for floor point j (the contact numbering of docs/contract.md)."""
+    contacts = scene.contacts
+    return [(f"vertex{k}", "ground") for k in range(contacts.n_rim)] + [
+        (f"bump{j}", "face") for j in range(len(contacts.floor_points))
+    ]
 
 
 def _integrator(name: str | None) -> mujoco.mjtIntegrator:
@@ -233,18 +232,18 @@ def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec
     body.mass = scene.body.mass
     body.ipos = [0.0, 0.0, 0.0]
     body.inertia = list(scene.body.inertia_diag)
-    sphere, points = mujoco.mjtGeom.mjGEOM_SPHERE, scene_points(scene)
-    if scene.ground.kind == "three_point":
-        for k, p in enumerate(points):
-            contact_geom(world, f"bump{k}", type=sphere, size=[r, 0, 0], pos=list(p))
+    sphere, contacts = mujoco.mjtGeom.mjGEOM_SPHERE, scene.contacts
+    if len(contacts.floor_points):  # floor points: spheres on the ground under a face
+        for j, p in enumerate(contacts.floor_points):
+            contact_geom(world, f"bump{j}", type=sphere, size=[r, 0, 0], pos=list(p))
         hh = FACE_HALF_THICKNESS_FRACTION * a
         contact_geom(
             body, "face", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[a, hh, 0], pos=[0, 0, r + hh]
         )
-    else:
+    if contacts.has_plane:  # rim vertices: spheres on the body over a plane
         plane = mujoco.mjtGeom.mjGEOM_PLANE
         contact_geom(world, "ground", type=plane, size=[0, 0, 1], pos=[0, 0, -r])
-        for k, p in enumerate(points):
+        for k, p in enumerate(contacts.rim_points):
             contact_geom(body, f"vertex{k}", type=sphere, size=[r, 0, 0], pos=list(p))
     for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
         spec.add_sensor(

@@ -28,7 +28,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core import records as R
-from .core.impact_laws import LAW_NAMES, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
+from .core.impact_laws import (
+    LAW_NAMES,
+    MAX_LAW_CONTACTS,
+    MAX_SEQUENTIAL_IMPACTS,
+    NOT_SETTLED,
+    SINGULAR,
+    TOO_MANY,
+)
 from .core.tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
 from .geometry import contact_kinematics, excess_energy
 from .quaternion import from_rotation_vector, multiply
@@ -56,10 +63,7 @@ def touching_contacts(scene, y: np.ndarray, always: list[int]) -> np.ndarray:
     """Contacts touching the ground at state y and not separating: gap ≤ TOUCH_ULPS ε
     (|z| + a) and normal velocity ≤ its roundoff, plus `always` (the contacts the loop
     named)."""
-    from .geometry import contact_points
-
-    pts = contact_points(scene.body, scene.ground)
-    gap, vn = contact_kinematics(y, pts, scene.ground.kind == "flat")
+    gap, vn = contact_kinematics(y, scene.contacts)
     gap, vn = gap[0], vn[0]
     a = scene.body.radius
     gap_tol = TOUCH_ULPS * EPS * (abs(y[2]) + a)
@@ -76,10 +80,10 @@ def apply_law(
     """In place on y: the impact of `contacts` under `law` (`moreau` or `sequential`;
     `order`: the sequential law's order of contacts, None the fastest first)."""
     from .compiled import function
+    from .simulate import model_record
 
     k = len(contacts)
-    i1, _, i3 = scene.body.inertia_diag
-    pts = np.ascontiguousarray(_points(scene), dtype=float)
+    pts = np.ascontiguousarray(scene.contacts.points, dtype=float)
     cs = np.ascontiguousarray(contacts, dtype=np.int64)
     pos = {int(c): i for i, c in enumerate(cs)}
     ordered = [pos[c] for c in (order or ()) if c in pos]
@@ -90,17 +94,11 @@ def apply_law(
     u_pre, lam, u_post, vec = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(2 * k)
     active, result = np.zeros(k, dtype=np.int64), np.zeros(2, dtype=np.int64)
     function("multi_impact")(
-        y, scene.ground.kind == "flat", pts, scene.body.mass, i1, i3, scene.restitution,
-        LAW_NAMES.index(law), cs, k, order_idx, len(order_idx), MAX_SEQUENTIAL_IMPACTS,
+        y, model_record(scene), pts, LAW_NAMES.index(law), cs, k, order_idx, len(order_idx),
+        MAX_SEQUENTIAL_IMPACTS,
         W, u_pre, lam, u_post, chol, vec, active, result,
     )  # fmt: skip
     return LawImpact(cs, lam, u_pre, u_post, int(result[0]), int(result[1]))
-
-
-def _points(scene):
-    from .geometry import contact_points
-
-    return contact_points(scene.body, scene.ground)
 
 
 def flat_bounce_end(scene, impact: LawImpact) -> float | None:
@@ -177,6 +175,11 @@ def continue_run(scene, problem, kernel, law: str, order, floor: float, run_prob
             )
         if impact.status == SINGULAR:
             return f"a contact of {contacts.tolist()} takes no impulse at t = {t_hi:.17g}"
+        if impact.status == TOO_MANY:
+            return (
+                f"{len(contacts)} contacts touch at t = {t_hi:.17g}: more than the "
+                f"{MAX_LAW_CONTACTS} the impact laws take (undecidable)"
+            )
         _push_impacts(problem, t_hi, t_lo, impact)
         tail = flat_bounce_end(scene, impact)
         if tail is not None and t_hi + tail <= float(problem.options["t_end"][0]):
