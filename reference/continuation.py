@@ -55,8 +55,9 @@ class LawImpact:
     impulses: np.ndarray
     u_pre: np.ndarray
     u_post: np.ndarray
-    status: int  # impact_laws.SETTLED / NOT_SETTLED / SINGULAR
+    status: int  # impact_laws.SETTLED / NOT_SETTLED / SINGULAR / TOO_MANY
     single_impacts: int
+    completed: bool = False  # the bounces were small: completed (taken plastic)
 
 
 def touching_contacts(scene, y: np.ndarray, always: list[int]) -> np.ndarray:
@@ -75,10 +76,16 @@ def touching_contacts(scene, y: np.ndarray, always: list[int]) -> np.ndarray:
 
 
 def apply_law(
-    scene, y: np.ndarray, contacts: np.ndarray, law: str, order: tuple[int, ...] | None = None
+    scene,
+    y: np.ndarray,
+    contacts: np.ndarray,
+    law: str,
+    order: tuple[int, ...] | None = None,
+    chatter_tol: float = 1e-6,
 ) -> LawImpact:
     """In place on y: the impact of `contacts` under `law` (`moreau` or `sequential`;
-    `order`: the sequential law's order of contacts, None the fastest first)."""
+    `order`: the sequential law's order of contacts, None the fastest first; bounces all
+    below chatter_tol × V completed, multi_impact.law_impact)."""
     from .compiled import function
     from .simulate import model_record
 
@@ -92,13 +99,13 @@ def apply_law(
     order_idx = np.array(ordered, dtype=np.int64)
     W, chol = np.zeros((k, k)), np.zeros((k, k))
     u_pre, lam, u_post, vec = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(2 * k)
-    active, result = np.zeros(k, dtype=np.int64), np.zeros(2, dtype=np.int64)
+    active, result = np.zeros(k, dtype=np.int64), np.zeros(3, dtype=np.int64)
     function("multi_impact")(
         y, model_record(scene), pts, LAW_NAMES.index(law), cs, k, order_idx, len(order_idx),
-        MAX_SEQUENTIAL_IMPACTS,
+        MAX_SEQUENTIAL_IMPACTS, chatter_tol,
         W, u_pre, lam, u_post, chol, vec, active, result,
     )  # fmt: skip
-    return LawImpact(cs, lam, u_pre, u_post, int(result[0]), int(result[1]))
+    return LawImpact(cs, lam, u_pre, u_post, int(result[0]), int(result[1]), bool(result[2]))
 
 
 def flat_bounce_end(scene, impact: LawImpact) -> float | None:
@@ -153,7 +160,9 @@ def energy_floor_for(scene, y: np.ndarray, excess0: float, floor: float) -> floa
 MAX_RESTARTS_AT_ONE_TIME = 64
 
 
-def continue_run(scene, problem, kernel, law: str, order, floor: float, run_problem) -> str | None:
+def continue_run(
+    scene, problem, kernel, law: str, order, floor: float, run_problem, chatter_tol: float
+) -> str | None:
     """Resume `problem` (the loop stopped undecidable) under `law` until it ends
     otherwise; returns a message that replaces the loop's, or None."""
     st = problem.state
@@ -167,7 +176,7 @@ def continue_run(scene, problem, kernel, law: str, order, floor: float, run_prob
             return f"the {law} law made no progress at t = {t_hi:.17g}: stopped (undecidable)"
         y = np.array(st["y"][0], dtype=float)
         contacts = touching_contacts(scene, y, law_contacts(st[0]))
-        impact = apply_law(scene, y, contacts, law, order)
+        impact = apply_law(scene, y, contacts, law, order, chatter_tol)
         if impact.status == NOT_SETTLED:
             return (
                 f"the {law} law did not settle after {impact.single_impacts} single impacts "

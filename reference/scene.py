@@ -62,10 +62,10 @@ MAX_ROTATION_VECTOR = 1e3
 # the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
 IMPACT_LAWS = ("paper", "moreau", "sequential")
 DEFAULT_IMPACT_LAW = "paper"
-# the simultaneity window [time unit of the scene]: 0 = strictly sequential (the core
-# orders contacts down to its time resolution, as before issue 31)
+# the simultaneity window [time unit of the scene]: contacts whose zeros are this close
+# are reached together.  0 (the default) = strictly sequential: the core orders contacts
+# down to its time resolution, as before issue 31 (docs/architecture.md, "Impact laws")
 DEFAULT_SIMULTANEITY_WINDOW = 0.0
-MAX_SIMULTANEITY_WINDOW = 0.0  # windows > 0 wait for the core's support (issue 31, B)
 SCALE_RANGE = (1e-50, 1e50)
 MAX_IMPACTS = 10_000_000
 MAX_SCENE_FILE_BYTES = 1 << 20
@@ -295,15 +295,9 @@ def check_impact_law(law: Any) -> str:
 
 
 def check_window(window: float) -> float:
-    """A simultaneity window: 0 (strictly sequential) until the compiled core applies
-    windows (MAX_SIMULTANEITY_WINDOW)."""
-    if not (math.isfinite(window) and 0.0 <= window):
+    """A simultaneity window: a finite time >= 0 (0: strictly sequential)."""
+    if not (math.isfinite(window) and 0.0 <= window <= DIMENSION_RANGE[1]):
         raise SceneError(f"simultaneity_window must be a finite time >= 0, got {window!r}")
-    if window > MAX_SIMULTANEITY_WINDOW:
-        raise SceneError(
-            f"simultaneity_window {window:g} > 0 is not supported by this build's core yet "
-            "(only 0: contacts ordered to the core's time resolution)"
-        )
     return float(window)
 
 

@@ -135,6 +135,7 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["invariants"] = contacts.invariants
     rec["sag"] = 1.0 - math.cos(math.pi / scene.body.n)
     rec["all_down"] = contacts.all_down
+    rec["window"] = scene.simultaneity_window
     return rec
 
 
@@ -213,6 +214,7 @@ def simulate(
     stats.compile_s the one-time compilation or loading that preceded it."""
     opts = options or ReferenceOptions()
     law, window = impact_law_of(scene, opts)
+    scene = scene.with_impact_law(law, window)  # the options' choice, as the core reads it
     compile_s = compiled.warm_up()
     t_end = float(t_end if t_end is not None else scene.run.t_end)
     problem = make_problem(scene, t_end, opts)
@@ -223,7 +225,7 @@ def simulate(
     if law != "paper" and continuation.undecidable(problem.state[0]):
         note = continuation.continue_run(
             scene, problem, kernel, law, opts.sequential_order, opts.energy_floor,
-            lambda k, p: run_problem(k, p, opts.max_samples, progress),
+            lambda k, p: run_problem(k, p, opts.max_samples, progress), opts.chatter_tol,
         )  # fmt: skip
         problem.options["energy_floor"] = opts.energy_floor  # (restarts rescale it)
     wall = time.perf_counter() - t0

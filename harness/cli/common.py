@@ -232,7 +232,7 @@ def add_impact_law(p: argparse.ArgumentParser) -> None:
         type=float_in(0.0, 1e50, what="a time window [s]"),
         metavar="T",
         help="contacts reaching the ground within T of each other are one simultaneous "
-        "impact (default: the scene's, else 0: strictly sequential; only 0 in this build)",
+        "impact under every law (default: the scene's, else 0: strictly sequential)",
     )
 
 

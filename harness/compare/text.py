@@ -144,9 +144,9 @@ def _header(result: CompareResult) -> list[str]:
     shape = "rod" if body.n == 2 else f"{body.n}-gon"
     head = (
         f"{scene.name}: {shape} on {scene.ground.name} ground, "
-        f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}, "
-        f"impact law {impact_law_text(ref.impact_law or 'paper', ref.simultaneity_window)}"
+        f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}"
     )
+    law = f"impact law: {impact_law_text(ref.impact_law or 'paper', ref.simultaneity_window)}"
     text = (
         f"reference: {ref.status.value} at t = {ref.t_final:.7g} s after {len(ref.impacts)} "
         f"impacts ({seconds(result.reference_wall_time_s)})"
@@ -156,7 +156,7 @@ def _header(result: CompareResult) -> list[str]:
     fit = result.reference_exponent
     if fit is not None and fit.c is not None:
         text += f"; energy exponent {fit.describe()}"
-    return [head, *textwrap.wrap(text, WIDTH, subsequent_indent="  ")]
+    return [head, law, *textwrap.wrap(text, WIDTH, subsequent_indent="  ")]
 
 
 def _verdict_table(result: CompareResult) -> str:

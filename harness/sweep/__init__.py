@@ -67,10 +67,11 @@ def config_from_args(args) -> SweepConfig:
         dt=float(dt) if (dt is not None and is_fixed_step(args.engine)) else None,
         min_decades=default_min_decades(args.engine),
         impact_law=getattr(args, "impact_law", None) or "paper",
+        simultaneity_window=float(getattr(args, "simultaneity_window", None) or 0.0),
         **extra,
     )
-    if getattr(args, "simultaneity_window", None):
-        raise _bad("--simultaneity-window > 0 is not supported by this build's core yet")
+    if getattr(args, "simultaneity_window", None) and args.engine != "reference":
+        raise _bad("--simultaneity-window applies to the reference engine only")
     check_config(config)
     return config
 
@@ -273,6 +274,7 @@ def summarise(config, df, store, statuses_now, n_before, n_missing, duplicates) 
         "command": "sweep exponent",
         "engine": config.engine,
         "impact_law": config.impact_law,
+        "simultaneity_window": config.simultaneity_window,
         "n": config.n,
         "out": str(store.root),
         "dir": str(store.dir),

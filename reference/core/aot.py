@@ -42,7 +42,7 @@ def signatures() -> dict:
         "free_acceleration_rows": void(f2, f8, f8, f8, f2),
         "length_scale_rows": void(f2, f8, f1),
         "multi_impact": void(
-            f1, rec(R.MODEL), f2, i8, i1, i8, i1, i8, i8, f2, f1, f1, f1, f2, f1, i1, i1
+            f1, rec(R.MODEL), f2, i8, i1, i8, i1, i8, i8, f8, f2, f1, f1, f1, f2, f1, i1, i1
         ),
     }
 

@@ -198,7 +198,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
             cs.together[n_land] = cs.cand[i]
             n_land += 1
     if n_hit:
-        n_hit = _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res)
+        n_hit = _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, model.window)
         close_contact_phase(state, model, stats, out)
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
@@ -214,7 +214,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
 
 
 @hot
-def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res):
+def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, window):
     """Append to cs.hitting the approaching contacts above their roundoff that are
     `reached_together` with the touching cs.cand[first], each gap known to
     max(its roundoff, gap_res) (the integrator's resolution of positions in a contact
@@ -222,7 +222,8 @@ def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res):
     tres0 = time_resolution(max(cs.noise[first], gap_res), cs.rate[first])
     for i in range(n_cand):
         if cs.gap[i] > cs.noise[i] and cs.rate[i] < -vnoise:
-            if reached_together(cs.gap[i], cs.rate[i], max(cs.noise[i], gap_res), tres0):
+            gap_i = max(cs.noise[i], gap_res)
+            if reached_together(cs.gap[i], cs.rate[i], gap_i, tres0, window):
                 cs.hitting[n_hit] = cs.cand[i]
                 n_hit += 1
     return n_hit
