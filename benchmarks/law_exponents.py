@@ -1,9 +1,10 @@
 """The energy exponent c under each impact law on the three-point ground (issue 31):
-the sweep's initial states (harness.sweep.grid.initial_state: q = (0.001 χ3, 0.001 χ4,
-1), p = (0.1 χ1, 0.1 χ2, −1)) for a disk on three bumps (b = 0.5 a), run by the exact
-reference to the singularity under `paper`, `moreau` and `sequential`; per γ the
-fraction of runs that reach the singularity and the mean c.  (`harness sweep exponent`
-covers the flat n-gon; its scenes have no ground option.)
+the sweep's random numbers χ (harness.sweep.grid.chi) in the three-point-disk scene's
+scale, q = (0.01 χ3, 0.01 χ4, 0.02), p = (0.05 χ1, 0.05 χ2, −0.05) (the sweep's own
+states, dropped from h = 1, bounce off the bumps: `left_model`), a disk on three bumps
+(b = 0.5 a), run by the exact reference to the singularity under `paper`, `moreau` and
+`sequential`; per γ the fraction of runs that reach the singularity and the mean c.
+(`harness sweep exponent` covers the flat n-gon; its scenes have no ground option.)
 
     python benchmarks/law_exponents.py --gyration 0.5 --restitution 0.2:0.8:4 --samples 20
 """
@@ -15,7 +16,7 @@ import statistics
 
 import numpy as np
 
-from harness.sweep.grid import initial_state
+from harness.sweep.grid import chi
 from reference import ReferenceOptions, simulate
 from reference.exponent import excess_energy_of, trajectory_exponent
 from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear
@@ -46,7 +47,9 @@ def main() -> None:
         for ig, gamma in enumerate(gammas):
             cs, statuses = [], []
             for s in range(args.samples):
-                q0, p0 = initial_state(args.seed, ig, 0, s)
+                x = chi(args.seed, ig, 0, s)
+                q0 = (0.01 * x[2], 0.01 * x[3], 0.02)
+                p0 = (0.05 * x[0], 0.05 * x[1], -0.05)
                 scene = three_point_scene(args.gyration, float(gamma), q0, p0)
                 opts = ReferenceOptions(sample_dt=scene.run.t_end, impact_law=law)
                 traj = simulate(scene, options=opts)

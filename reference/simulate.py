@@ -214,7 +214,8 @@ def simulate(
     stats.compile_s the one-time compilation or loading that preceded it."""
     opts = options or ReferenceOptions()
     law, window = impact_law_of(scene, opts)
-    scene = scene.with_impact_law(law, window)  # the options' choice, as the core reads it
+    if (law, window) != (scene.impact_law, scene.simultaneity_window):
+        scene = scene.with_impact_law(law, window)  # the options' choice, for the core
     compile_s = compiled.warm_up()
     t_end = float(t_end if t_end is not None else scene.run.t_end)
     problem = make_problem(scene, t_end, opts)
