@@ -17,6 +17,7 @@ from .contacts import (
     contact_kind,
     length_rate,
     length_scale,
+    normal_velocity,
     rate_noise,
     reached_together,
     time_resolution,
@@ -301,6 +302,43 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
 
 
 @hot
+def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed):
+    """Crossed contacts (cs.together[:n_crossed]) reached below the clock's resolution:
+    touching now.  Approaching ones (a chunk cut where one reached the ground a roundoff
+    short of its noise band) are an impact with the held ones, as in `_touching_event`
+    (held instead, a triangle's third vertex landing at speed beside a held edge ended
+    the motion "all contacts down" with its energy); the others, with no approach speed
+    and no downward acceleration (a tie the LCP cannot see) whose gaps still fall,
+    land, held with the others."""
+    _cut_chunk(state, ws, s_star)
+    close_contact_phase(state, model, stats, out)
+    n_hit = _approaching(state.y, model, pts, cs.together, n_crossed, cs.hitting)
+    if n_hit:
+        for i in range(state.n_active):
+            ws.held[i] = state.active[i]
+        resolve_impact(
+            state, model, pts, opts, stats, out, ws, cs.hitting, n_hit, ws.held, state.n_active
+        )
+        return DONE
+    activate(state, model, pts, ws, stats, cs.together, n_crossed)
+    return DONE
+
+
+@hot
+def _approaching(y, model, pts, contacts, n, out):
+    """The contacts[:n] approaching the ground at y (normal velocity below its roundoff)
+    to out; returns how many."""
+    vnoise = rate_noise(y, model.radius)
+    m = 0
+    for i in range(n):
+        kind = contact_kind(model, contacts[i])
+        if normal_velocity(y, contact_frame(y, kind, pts, contacts[i]), kind) < -vnoise:
+            out[m] = contacts[i]
+            m += 1
+    return m
+
+
+@hot
 def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
     """The first time in (0, h] the crossed contacts (cs.together[:n_crossed]) reach the
     ground: the chunk integrated again from its start watching their gaps, the zero
@@ -370,13 +408,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, r.s, n_crossed)
         _drop_samples_after(out, ns0, state, s_star)
         if two_sum_add(state.t_hi, state.t_lo, s_star)[0] == state.t_hi:
-            # below the clock's resolution: contacts touching now with no approach
-            # speed and no downward acceleration (a tie the LCP cannot see) whose gaps
-            # still fall: they land, held with the others
-            _cut_chunk(state, ws, s_star)
-            close_contact_phase(state, model, stats, out)
-            activate(state, model, pts, ws, stats, cs.together, n_crossed)
-            return DONE
+            return _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed)
         return _cut_chunk(state, ws, s_star)
     if r.status == INT_CROSSING:  # an approaching contact reached the ground: its impact next
         stats.contact_chunks += 1
