@@ -163,3 +163,28 @@ def test_a_start_just_above_the_ground_is_one_simultaneous_impact_within_the_win
     paper = simulate(lifted, options=ReferenceOptions(simultaneity_window=1e-9))
     assert paper.status.value == "simultaneous_impact"
     assert paper.simultaneity_window == 1e-9
+
+
+STALLS = "a contact phase stalls beside a vertex leaving a flat triangle (issue 31, open)"
+
+
+@pytest.mark.parametrize(
+    "sample", [0, 2, 3, pytest.param(1, marks=pytest.mark.xfail(reason=STALLS, strict=True))]
+)
+def test_a_motion_that_ends_at_the_singularity_has_no_energy_left(sample):
+    """The ρ = 0.5 triangle of the sweep (γ = 0.6) under Moreau's law: when the run
+    ends at the singularity the energy above the resting level is gone (a third vertex
+    landing at speed beside a held edge is an impact, not a silent hold; a body exactly
+    flat after a simultaneous impact but tilting away is not below the tilt floor)."""
+    from harness.sweep.grid import SweepConfig, initial_state
+    from harness.sweep.run import polygon_scene
+    from reference.exponent import excess_energy_of
+
+    config = SweepConfig(n=3, gyration=(0.5, 0.5, 1), restitution=(0.6, 0.6, 1), samples=4,
+                         seed=0, engine="reference", impact_law="moreau")  # fmt: skip
+    q0, p0 = initial_state(0, 2, 0, sample)
+    scene = polygon_scene(config, 0.5, 0.6, q0, p0)
+    traj = simulate(scene, options=ReferenceOptions(sample_dt=1.0))
+    assert traj.status.value == "singularity"
+    excess = excess_energy_of(traj, scene)
+    assert excess[-1] <= 1e-9 * excess[0]
