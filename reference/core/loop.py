@@ -92,7 +92,7 @@ def extrapolate_singularity(out, t_hi):
 @hot
 def _below_tilt_floor(state, model, opts, y, out):
     """After impacts, the tilt α ≈ 2 |(x, y)| of the attitude quaternion is below
-    TILT_FLOOR: nonzero, or exactly zero with a contact held, and not tilting (the rim
+    TILT_FLOOR: nonzero, or exactly zero with a contact held and not tilting (the rim
     speed a|ω_h| of the rotation about horizontal axes at most chatter_tol × V).  A body
     exactly flat with no contact held has just landed flat: the event search reports its
     simultaneous contacts; one exactly flat but tilting away (a vertex leaving a
@@ -100,10 +100,12 @@ def _below_tilt_floor(state, model, opts, y, out):
     if out.counts[N_IMPACTS] == 0:
         return False
     h = math.hypot(y[4], y[5])
-    if not (h < 0.5 * TILT_FLOOR and (h > 0.0 or state.n_active > 0)):
+    if not h < 0.5 * TILT_FLOOR:
         return False
+    if h > 0.0:
+        return True
     tilting = model.radius * math.hypot(y[10], y[11])
-    return tilting <= opts.chatter_tol * velocity_scale(y, model.radius)
+    return state.n_active > 0 and tilting <= opts.chatter_tol * velocity_scale(y, model.radius)
 
 
 @hot
