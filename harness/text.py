@@ -17,6 +17,8 @@ def format_simulate(traj: Trajectory) -> str:
         f"status      {traj.status.value}: {traj.message}",
         f"t_final     {traj.t_final:.17g}",
     ]
+    if traj.impact_law is not None:
+        lines.append(f"impact law  {impact_law_text(traj.impact_law, traj.simultaneity_window)}")
     if traj.t_singularity is not None:
         lines.append(f"t_sing      {traj.t_singularity:.17g}")
     lines += [
@@ -48,6 +50,11 @@ def _escaped(ch: str) -> str:
     if ch in "\n\t" or not (code < 32 or 127 <= code < 160 or code in _BIDI):
         return ch
     return f"\\x{code:02x}" if code < 256 else f"\\u{code:04x}"
+
+
+def impact_law_text(law: str, window: float | None) -> str:
+    """'moreau (simultaneity window 0)': the law of simultaneous impacts a run applied."""
+    return f"{law} (simultaneity window {window or 0:g})"
 
 
 def num(x: Any, spec: str = ".3g") -> str:

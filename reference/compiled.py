@@ -34,6 +34,7 @@ EXPORTS = {
     "energy_rows": "arrays",
     "free_acceleration_rows": "arrays",
     "length_scale_rows": "arrays",
+    "multi_impact": "multi_impact",
 }
 
 _aot = None

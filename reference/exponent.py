@@ -339,6 +339,16 @@ def pre_impact_samples(traj: Trajectory) -> np.ndarray:
     return samples_before[rank[n_s:]] - 1
 
 
+def distinct_impacts(t_i: np.ndarray, lo_i: np.ndarray) -> np.ndarray:
+    """Indices of the first impact row at each distinct time (t, t_lo): the rows of a
+    simultaneous impact (one per contact, all at one time; impact laws other than the
+    paper's) are one impact of the series."""
+    if len(t_i) == 0:
+        return np.zeros(0, dtype=np.int64)
+    same = (np.diff(t_i) == 0) & (np.diff(lo_i) == 0)
+    return np.flatnonzero(np.concatenate([[True], ~same]))
+
+
 def _resolved_impacts(t_i: np.ndarray, lo_i: np.ndarray, tol: float) -> tuple[np.ndarray, int]:
     """Intervals before each impact (the first from t = 0) and the index K of the last
     impact whose interval is resolved (every interval up to it ≥ tol·max(t, 1))."""
@@ -411,6 +421,9 @@ def trajectory_exponent(
     has_lo = traj.t_lo is not None or bool(np.any(lo_i != 0))
     tol = resolution if resolution is not None else (1e-28 if has_lo else 1e-13)
     idx = pre_impact_samples(traj)
+    first = distinct_impacts(t_i, lo_i)  # a simultaneous impact is one impact
+    t_i, lo_i, idx = t_i[first], lo_i[first], idx[first]
+    N = len(t_i)
     E_pre = np.where(idx >= 0, E[np.maximum(idx, 0)], np.nan)
     tau, K = _resolved_impacts(t_i, lo_i, tol)
     e_after = np.append(E_pre[1 : K + 1], E_pre[K + 1] if K + 1 < N else E[-1])

@@ -1,6 +1,6 @@
-"""Settings of the exact reference that a user may change: sampling, tolerances and the
-search method.  Everything else is a named tolerance of the model
-(reference.core.tolerances)."""
+"""Settings of the exact reference that a user may change: sampling, tolerances, the
+search method and the impact law of simultaneous impacts.  Everything else is a named
+tolerance of the model (reference.core.tolerances)."""
 
 from __future__ import annotations
 
@@ -23,6 +23,15 @@ class ReferenceOptions:
     window_search: large polygons (n > 19) examine only the vertices near the ground at
       each search step (False: every vertex; the same events, slower).
     work_budget: loop steps between returns to Python (progress display, Ctrl-C).
+    impact_law: how several contacts touching at an impact are resolved: `paper` (the
+      paper's rule: the run ends `simultaneous_impact`), `moreau` or `sequential`
+      (reference.core.impact_laws; docs/architecture.md, "Impact laws"); None: the
+      scene's `impact_law` (default `paper`).
+    simultaneity_window: contacts reaching the ground within this time of each other
+      count as one simultaneous impact; None: the scene's (default 0, strictly
+      sequential as before).
+    sequential_order: the `sequential` law's order of contacts (sweeps over it); None:
+      the fastest approaching first.
     """
 
     sample_dt: float | None = None
@@ -32,3 +41,6 @@ class ReferenceOptions:
     max_samples: int = 500_000
     window_search: bool = True
     work_budget: int = 200_000
+    impact_law: str | None = None
+    simultaneity_window: float | None = None
+    sequential_order: tuple[int, ...] | None = None

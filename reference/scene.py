@@ -62,6 +62,13 @@ MIN_BUMP_RADIUS = 1e-6
 MAX_SPEED = 1e3
 MAX_POSITION = 1e6
 MAX_ROTATION_VECTOR = 1e3
+# the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
+IMPACT_LAWS = ("paper", "moreau", "sequential")
+DEFAULT_IMPACT_LAW = "paper"
+# the simultaneity window [time unit of the scene]: contacts whose zeros are this close
+# are reached together.  0 (the default) = strictly sequential: the core orders contacts
+# down to its time resolution, as before issue 31 (docs/architecture.md, "Impact laws")
+DEFAULT_SIMULTANEITY_WINDOW = 0.0
 SCALE_RANGE = (1e-50, 1e50)
 MAX_IMPACTS = 10_000_000
 MAX_SCENE_FILE_BYTES = 1 << 20
@@ -135,6 +142,8 @@ class Scene:
     gravity: float = 1.0
     description: str = ""
     run: RunSettings = field(default_factory=RunSettings)
+    impact_law: str = DEFAULT_IMPACT_LAW
+    simultaneity_window: float = DEFAULT_SIMULTANEITY_WINDOW
 
     @property
     def contacts(self) -> GroundContacts:
@@ -155,6 +164,17 @@ class Scene:
         scene = replace(self, run=replace(self.run, **changes))
         check_scene(scene)
         return scene
+
+    def with_impact_law(self, law: str | None = None, window: float | None = None) -> Scene:
+        """The scene with another impact law and/or simultaneity window (None: keep),
+        checked like a scene file's keys."""
+        return replace(
+            self,
+            impact_law=self.impact_law if law is None else check_impact_law(law),
+            simultaneity_window=(
+                self.simultaneity_window if window is None else check_window(window)
+            ),
+        )
 
     def scaled(self, eps: float, name: str = "--scale") -> Scene:
         """Apply the paper's scaling invariance to the linear initial coordinates:
@@ -195,7 +215,10 @@ def initial_from_linear(q, p) -> InitialState:
 
 # --------------------------------------------------------------------------- parsing
 
-_TOP_KEYS = {"name", "description", "gravity", "restitution", "body", "ground", "initial", "run"}
+_TOP_KEYS = {
+    "name", "description", "gravity", "restitution", "impact_law", "simultaneity_window",
+    "body", "ground", "initial", "run",
+}  # fmt: skip
 _BODY_KEYS = {"n", "radius", "mass", "gyration"}
 _GROUND_KEYS = {"kind", "bump_radius"}
 _INITIAL_LINEAR = {"q", "p", "scale"}
@@ -295,9 +318,27 @@ def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
         ground=_parse_ground(_optional_table("ground", data), body),
         initial=_parse_initial(_table("initial", data)),
         run=_parse_run(_optional_table("run", data)),
+        impact_law=check_impact_law(data.get("impact_law", DEFAULT_IMPACT_LAW)),
+        simultaneity_window=check_window(
+            _number("simultaneity_window", data.get("simultaneity_window", 0.0))
+        ),
     )
     check_scene(scene)
     return scene
+
+
+def check_impact_law(law: Any) -> str:
+    """One of IMPACT_LAWS."""
+    if law not in IMPACT_LAWS:
+        raise SceneError(f"impact_law must be one of {', '.join(IMPACT_LAWS)}, got {law!r}")
+    return law
+
+
+def check_window(window: float) -> float:
+    """A simultaneity window: a finite time >= 0 (0: strictly sequential)."""
+    if not (math.isfinite(window) and 0.0 <= window <= DIMENSION_RANGE[1]):
+        raise SceneError(f"simultaneity_window must be a finite time >= 0, got {window!r}")
+    return float(window)
 
 
 def _parse_body(b: dict) -> Body:

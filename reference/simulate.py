@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import compiled
+from . import compiled, continuation
 from .checks import check_reference_options, run_horizon
 from .core import records as R
 from .core.records import (
@@ -32,7 +32,7 @@ from .core.records import (
 from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
-from .scene import Scene, scene_from_dict
+from .scene import Scene, check_impact_law, check_window, scene_from_dict
 from .stats import RunStats
 from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
 
@@ -137,6 +137,7 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["invariants"] = contacts.invariants
     rec["sag"] = 1.0 - math.cos(math.pi / scene.body.n)
     rec["all_down"] = contacts.all_down
+    rec["window"] = scene.simultaneity_window
     return rec
 
 
@@ -220,13 +221,39 @@ def simulate(
     opts = ReferenceOptions() if options is None else options
     t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
     check_reference_options(opts)
+    law, window = impact_law_of(scene, opts)
+    if (law, window) != (scene.impact_law, scene.simultaneity_window):
+        scene = scene.with_impact_law(law, window)  # the options' choice, for the core
     compile_s = load_event_loop()
     problem = make_problem(scene, t_end, opts)
     kernel = compiled.run_events()
     t0 = time.perf_counter()
     run_problem(kernel, problem, opts.max_samples, progress)
+    note = None
+    if law != "paper" and continuation.undecidable(problem.state[0]):
+        note = continuation.continue_run(
+            scene, problem, kernel, law, opts.sequential_order, opts.energy_floor,
+            lambda k, p: run_problem(k, p, opts.max_samples, progress), opts.chatter_tol,
+        )  # fmt: skip
+        problem.options["energy_floor"] = opts.energy_floor  # (restarts rescale it)
     wall = time.perf_counter() - t0
-    return _trajectory(scene, problem, opts, t_end, wall, compile_s)
+    traj = _trajectory(scene, problem, opts, t_end, wall, compile_s)
+    traj.impact_law, traj.simultaneity_window = law, window
+    if note is not None:
+        traj.message = note
+    return traj
+
+
+def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
+    """The impact law and simultaneity window of a run: the options' if set, else the
+    scene's."""
+    law = opts.impact_law if opts.impact_law is not None else scene.impact_law
+    window = (
+        opts.simultaneity_window
+        if opts.simultaneity_window is not None
+        else scene.simultaneity_window
+    )
+    return check_impact_law(law), check_window(window)
 
 
 # A rough cost of compiling the loop just in time on a 2-core machine (measured).

@@ -83,6 +83,10 @@ class Trajectory:
     stats: Mapping[str, Any] = field(default_factory=dict)  # a dict, or RunStats
     t_lo: np.ndarray | None = None
     dt: float | None = None  # fixed timestep of an engine run, None for event-driven
+    # the impact law of simultaneous impacts and its simultaneity window, for simulators
+    # that apply one (the reference, the linear model); None for the others
+    impact_law: str | None = None
+    simultaneity_window: float | None = None
 
     @classmethod
     def failed(cls, engine: str, scene: str, dt: float | None, message: str) -> Trajectory:
@@ -192,6 +196,9 @@ class Trajectory:
         }
         if self.dt is not None:
             doc["dt"] = self.dt
+        if self.impact_law is not None:
+            doc["impact_law"] = self.impact_law
+            doc["simultaneity_window"] = self.simultaneity_window
         if with_impacts:
             doc["impacts"] = [e.to_dict() for e in self.impacts]
         return doc

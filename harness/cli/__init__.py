@@ -28,6 +28,7 @@ from ..text import terminal_safe
 from . import (
     analyze,
     bench,
+    branches,
     compare,
     engines,
     fidelity,
@@ -46,6 +47,7 @@ COMMANDS = (
     engines,
     simulate,
     compare,
+    branches,
     bench,
     stress,
     fidelity,

@@ -7,6 +7,7 @@ from .common import (
     add_dt,
     add_engine,
     add_force,
+    add_impact_law,
     add_json,
     add_scene,
     add_t_end,
@@ -35,6 +36,7 @@ def register(sub) -> None:
     add_engine(b, many="default: every installed engine")
     add_dt(b, many="default: 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 1e-6")
     add_t_end(b)
+    add_impact_law(b)
     b.add_argument(
         "--repeats",
         type=int_in(1, 1000),

@@ -224,6 +224,29 @@ def add_scale(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_impact_law(p: argparse.ArgumentParser) -> None:
+    """--impact-law NAME and --simultaneity-window T: how the reference resolves contacts
+    touching together (docs/architecture.md, "Impact laws"); default: the scene's."""
+    from reference.scene import IMPACT_LAWS
+
+    p.add_argument(
+        "--impact-law",
+        choices=IMPACT_LAWS,
+        metavar="NAME",
+        help="impact law of simultaneous impacts in the reference: paper (the run ends "
+        "simultaneous_impact), moreau (Moreau's frictionless law over every touching "
+        "contact) or sequential (single impacts, the fastest approach first) "
+        "(default: the scene's impact_law, else paper)",
+    )
+    p.add_argument(
+        "--simultaneity-window",
+        type=float_in(0.0, 1e50, what="a time window [s]"),
+        metavar="T",
+        help="contacts reaching the ground within T of each other are one simultaneous "
+        "impact under every law (default: the scene's, else 0: strictly sequential)",
+    )
+
+
 def add_max_steps(p: argparse.ArgumentParser) -> None:
     from ..simulators import DEFAULT_MAX_STEPS
 
@@ -362,7 +385,14 @@ def load_scene_arg(args):
     scene = resolve_scene(args.scene)
     if getattr(args, "scale", None) is not None:
         scene = scene.scaled(args.scale)
-    return scene
+    return with_impact_law_args(scene, args)
+
+
+def with_impact_law_args(scene, args):
+    """The scene with --impact-law / --simultaneity-window applied (when given)."""
+    return scene.with_impact_law(
+        getattr(args, "impact_law", None), getattr(args, "simultaneity_window", None)
+    )
 
 
 def scene_inputs(args) -> list:

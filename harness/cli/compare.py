@@ -8,6 +8,7 @@ from .common import (
     add_engine,
     add_force,
     add_horizon,
+    add_impact_law,
     add_json,
     add_max_steps,
     add_scale,
@@ -34,6 +35,7 @@ def register(sub) -> None:
     add_engine(c, many="at least one")
     add_dt(c, many="default: 1e-4")
     add_t_end(c)
+    add_impact_law(c)
     add_scale(c)
     add_max_steps(c)
     c.add_argument(

@@ -7,6 +7,7 @@ from .common import (
     add_engine,
     add_force,
     add_horizon,
+    add_impact_law,
     add_json,
     budget,
     emit,
@@ -31,6 +32,7 @@ def register(sub) -> None:
     f.add_argument("scene", help="a built-in scene or a file, given in (q, p)")
     add_engine(f, many="default: every installed engine but reference and linear")
     add_dt(f, many="default: 1e-3, 1e-4, 1e-5")
+    add_impact_law(f)
     a, b, k = DEFAULT_EPS_GRID
     f.add_argument(
         "--eps-grid",

@@ -9,6 +9,7 @@ from .common import (
     add_dt,
     add_engine,
     add_force,
+    add_impact_law,
     add_json,
     add_max_steps,
     add_scale,
@@ -37,6 +38,7 @@ def register(sub) -> None:
     add_engine(s)
     add_dt(s)
     add_t_end(s)
+    add_impact_law(s)
     add_scale(s)
     add_max_steps(s)
     s.add_argument(

@@ -6,6 +6,7 @@ from .common import (
     MAX_GRID_POINTS,
     Parser,
     add_engine,
+    add_impact_law,
     add_json,
     duration,
     emit,
@@ -65,6 +66,7 @@ def register(sub) -> None:
         "and its grid point and sample number)",
     )
     add_engine(e, default="linear")
+    add_impact_law(e)
     e.add_argument(
         "--dt",
         type=timestep,

@@ -101,6 +101,8 @@ class CompareResult:
             "kind": "compare",
             "scene": self.scene.name,
             "restitution": self.scene.restitution,
+            "impact_law": self.reference.impact_law,
+            "simultaneity_window": self.reference.simultaneity_window,
             "reference": ref,
             "engines": engines,
             "first_to_diverge": None

@@ -12,7 +12,7 @@ from reference.scene import Scene
 from reference.trajectory import Status
 
 from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
-from ..text import table
+from ..text import impact_law_text, table
 
 if TYPE_CHECKING:
     from . import CompareResult, EngineRun
@@ -202,6 +202,7 @@ def _header(result: CompareResult) -> list[str]:
         f"{scene.name}: {shape} on {scene.ground.name} ground, "
         f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}"
     )
+    law = f"impact law: {impact_law_text(ref.impact_law or 'paper', ref.simultaneity_window)}"
     text = (
         f"reference: {ref.status.value} at t = {ref.t_final:.7g} s after {len(ref.impacts)} "
         f"impacts ({seconds(result.reference_wall_time_s)})"
@@ -211,7 +212,7 @@ def _header(result: CompareResult) -> list[str]:
     fit = result.reference_exponent
     if fit is not None and fit.c is not None:
         text += f"; energy exponent {fit.describe()}"
-    return [head, *textwrap.wrap(text, WIDTH, subsequent_indent="  ")]
+    return [head, law, *textwrap.wrap(text, WIDTH, subsequent_indent="  ")]
 
 
 def _verdict_table(result: CompareResult) -> str:

@@ -53,8 +53,12 @@ def config_from_args(args) -> SweepConfig:
         engine=args.engine,
         dt=float(dt) if (dt is not None and is_fixed_step(args.engine)) else None,
         min_decades=default_min_decades(args.engine),
+        impact_law=getattr(args, "impact_law", None) or "paper",
+        simultaneity_window=float(getattr(args, "simultaneity_window", None) or 0.0),
         **extra,
     )
+    if getattr(args, "simultaneity_window", None) and args.engine != "reference":
+        raise _bad("--simultaneity-window applies to the reference engine only")
     check_config(config)
     return config
 

@@ -47,9 +47,15 @@ class SweepConfig:
     max_impacts: int = 20000
     t_end: float = 200.0
     min_decades: float = 6.0
+    impact_law: str = "paper"  # the reference's law of simultaneous impacts
+    simultaneity_window: float = 0.0  # and its window
 
     def to_dict(self) -> dict:
         d = asdict(self)
+        if d["impact_law"] == "paper":  # manifests written before the keys stay valid
+            del d["impact_law"]
+        if d["simultaneity_window"] == 0.0:
+            del d["simultaneity_window"]
         d["gyration"] = list(self.gyration)
         d["restitution"] = list(self.restitution)
         d["version"] = MANIFEST_VERSION

@@ -45,6 +45,8 @@ def polygon_scene(config: SweepConfig, rho: float, gamma: float, q0, p0):
         restitution=gamma,
         gravity=config.gravity,
         run=RunSettings(t_end=config.t_end, max_impacts=config.max_impacts),
+        impact_law=config.impact_law,
+        simultaneity_window=config.simultaneity_window,
     )
 
 

@@ -37,6 +37,8 @@ def summarise(config, df, store, statuses_now, n_before, n_missing, refused_now=
     return {
         "command": "sweep exponent",
         "engine": config.engine,
+        "impact_law": config.impact_law,
+        "simultaneity_window": config.simultaneity_window,
         "n": config.n,
         "out": str(store.root),
         "dir": str(store.dir),

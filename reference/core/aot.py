@@ -29,6 +29,7 @@ def signatures() -> dict:
     f2 = types.Array(types.float64, 2, "C")
     f1 = types.Array(types.float64, 1, "C")
     i2 = types.Array(types.int64, 2, "C")
+    i1 = types.Array(types.int64, 1, "C")
     f8, i8, void = types.float64, types.int64, types.void
     return {
         "run_events": types.int64(rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2),
@@ -42,6 +43,9 @@ def signatures() -> dict:
         "energy_rows": void(f2, i8, f8, f8, f8, f8, f2),
         "free_acceleration_rows": void(f2, f8, f8, f8, f2),
         "length_scale_rows": void(f2, f8, f1),
+        "multi_impact": void(
+            f1, rec(R.MODEL), f2, i8, i1, i8, i1, i8, i8, f8, f2, f1, f1, f1, f2, f1, i1, i1
+        ),
     }
 
 

@@ -236,9 +236,9 @@ def time_resolution(noise, rate):
 
 
 @hot
-def reached_together(gap, rate, noise, tres0):
+def reached_together(gap, rate, noise, tres0, window):
     """Whether a contact approaching (rate < 0) reaches the ground together with one
     reached now whose time resolution is tres0: its zero, gap/|rate| away, is within
     SIMULTANEOUS_FACTOR × the sum of their time resolutions (the model cannot order
-    them)."""
-    return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0)
+    them) plus the simultaneity window (model.window; 0: strictly sequential)."""
+    return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0) + window

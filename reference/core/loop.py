@@ -24,11 +24,11 @@ import math
 from numba import njit
 
 from .clock import time_until
-from .contacts import off_face
+from .contacts import off_face, velocity_scale
 from .events import end_run, start
 from .inertia import excess_energy
 from .jit import hot
-from .layout import QX, QY, STATE_SIZE
+from .layout import QX, QY, STATE_SIZE, WX, WY
 from .output import Output
 from .phases import (
     NEEDS_ROWS,
@@ -91,15 +91,22 @@ def extrapolate_singularity(out, t_hi):
 
 
 @hot
-def _below_tilt_floor(state, y, out):
+def _below_tilt_floor(state, model, opts, y, out):
     """After impacts, the tilt α ≈ 2 |(x, y)| of the attitude quaternion is below
-    TILT_FLOOR: nonzero, or exactly zero with a contact held.  A body exactly flat with
-    no contact held has just landed flat: the event search reports its simultaneous
-    contacts."""
+    TILT_FLOOR: nonzero, or exactly zero with a contact held and not tilting (the rim
+    speed a|ω_h| of the rotation about horizontal axes at most chatter_tol × V).  A body
+    exactly flat with no contact held has just landed flat: the event search reports its
+    simultaneous contacts; one exactly flat but tilting away (a vertex leaving a
+    simultaneous impact beside held ones, under an impact law) is not at rest either."""
     if out.counts[N_IMPACTS] == 0:
         return False
     h = math.hypot(y[QX], y[QY])
-    return h < 0.5 * TILT_FLOOR and (h > 0.0 or state.n_active > 0)
+    if not h < 0.5 * TILT_FLOOR:
+        return False
+    if h > 0.0:
+        return True
+    tilting = model.radius * math.hypot(y[WX], y[WY])
+    return state.n_active > 0 and tilting <= opts.chatter_tol * velocity_scale(y, model.radius)
 
 
 @hot
@@ -121,7 +128,7 @@ def _motion_ended(state, model, opts, out):
             end_run(state, STATUS_ENERGY_EXHAUSTED, none, 0)
             state.t_singularity = extrapolate_singularity(out, state.t_hi)
             return True
-    if _below_tilt_floor(state, y, out):
+    if _below_tilt_floor(state, model, opts, y, out):
         end_run(state, STATUS_TILT_FLOOR, none, 0)
         state.t_singularity = extrapolate_singularity(out, state.t_hi)
         return True

@@ -17,6 +17,7 @@ from .contacts import (
     contact_kind,
     length_rate,
     length_scale,
+    normal_velocity,
     rate_noise,
     reached_together,
     time_resolution,
@@ -199,7 +200,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
             cs.together[n_land] = cs.cand[i]
             n_land += 1
     if n_hit:
-        n_hit = _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res)
+        n_hit = _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, model.window)
         close_contact_phase(state, model, stats, out)
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
@@ -215,7 +216,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
 
 
 @hot
-def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res):
+def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, window):
     """Append to cs.hitting the approaching contacts above their roundoff that are
     `reached_together` with the touching cs.cand[first], each gap known to
     max(its roundoff, gap_res) (the integrator's resolution of positions in a contact
@@ -223,7 +224,8 @@ def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res):
     tres0 = time_resolution(max(cs.noise[first], gap_res), cs.rate[first])
     for i in range(n_cand):
         if cs.gap[i] > cs.noise[i] and cs.rate[i] < -vnoise:
-            if reached_together(cs.gap[i], cs.rate[i], max(cs.noise[i], gap_res), tres0):
+            gap_i = max(cs.noise[i], gap_res)
+            if reached_together(cs.gap[i], cs.rate[i], gap_i, tres0, window):
                 cs.hitting[n_hit] = cs.cand[i]
                 n_hit += 1
     return n_hit
@@ -301,6 +303,43 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
 
 
 @hot
+def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed):
+    """Crossed contacts (cs.together[:n_crossed]) reached below the clock's resolution:
+    touching now.  Approaching ones (a chunk cut where one reached the ground a roundoff
+    short of its noise band) are an impact with the held ones, as in `_touching_event`
+    (held instead, a triangle's third vertex landing at speed beside a held edge ended
+    the motion "all contacts down" with its energy); the others, with no approach speed
+    and no downward acceleration (a tie the LCP cannot see) whose gaps still fall,
+    land, held with the others."""
+    _cut_chunk(state, ws, s_star)
+    close_contact_phase(state, model, stats, out)
+    n_hit = _approaching(state.y, model, pts, cs.together, n_crossed, cs.hitting)
+    if n_hit:
+        for i in range(state.n_active):
+            ws.held[i] = state.active[i]
+        resolve_impact(
+            state, model, pts, opts, stats, out, ws, cs.hitting, n_hit, ws.held, state.n_active
+        )
+        return DONE
+    activate(state, model, pts, ws, stats, cs.together, n_crossed)
+    return DONE
+
+
+@hot
+def _approaching(y, model, pts, contacts, n, out):
+    """The contacts[:n] approaching the ground at y (normal velocity below its roundoff)
+    to out; returns how many."""
+    vnoise = rate_noise(y, model.radius)
+    m = 0
+    for i in range(n):
+        kind = contact_kind(model, contacts[i])
+        if normal_velocity(y, contact_frame(y, kind, pts, contacts[i]), kind) < -vnoise:
+            out[m] = contacts[i]
+            m += 1
+    return m
+
+
+@hot
 def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
     """The first time in (0, h] the crossed contacts (cs.together[:n_crossed]) reach the
     ground: the chunk integrated again from its start watching their gaps, the zero
@@ -370,13 +409,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, r.s, n_crossed)
         _drop_samples_after(out, ns0, state, s_star)
         if two_sum_add(state.t_hi, state.t_lo, s_star)[0] == state.t_hi:
-            # below the clock's resolution: contacts touching now with no approach
-            # speed and no downward acceleration (a tie the LCP cannot see) whose gaps
-            # still fall: they land, held with the others
-            _cut_chunk(state, ws, s_star)
-            close_contact_phase(state, model, stats, out)
-            activate(state, model, pts, ws, stats, cs.together, n_crossed)
-            return DONE
+            return _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed)
         return _cut_chunk(state, ws, s_star)
     if r.status == INT_CROSSING:  # an approaching contact reached the ground: its impact next
         stats.contact_chunks += 1

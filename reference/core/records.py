@@ -65,6 +65,7 @@ MODEL = np.dtype(
         ("sag", np.float64),  # 1 − cos(π/n): how far a vertex sits above the circle's
         # lowest point, per a sin α, when that point is midway between two vertices
         ("all_down", np.int64),  # contacts held together that end the motion
+        ("window", np.float64),  # simultaneity window: zeros this close are reached together
     ]
 )
 

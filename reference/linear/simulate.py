@@ -380,6 +380,8 @@ def trajectory_from_run(
         phases=phases,
         stats=stats,
         t_lo=lo_all,
+        impact_law="paper",  # the linear kernel applies the paper's rule only (so far)
+        simultaneity_window=0.0,
     )
 
 
