@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .core import layout as L
 from .core import records as R
 from .core.impact_laws import (
     LAW_NAMES,
@@ -67,8 +68,8 @@ def touching_contacts(scene, y: np.ndarray, always: list[int]) -> np.ndarray:
     gap, vn = contact_kinematics(y, scene.contacts)
     gap, vn = gap[0], vn[0]
     a = scene.body.radius
-    gap_tol = TOUCH_ULPS * EPS * (abs(y[2]) + a)
-    v_scale = np.linalg.norm(y[7:10]) + a * np.linalg.norm(y[10:13])
+    gap_tol = TOUCH_ULPS * EPS * (abs(y[L.Z]) + a)
+    v_scale = np.linalg.norm(y[L.VELOCITY]) + a * np.linalg.norm(y[L.ANGULAR_VELOCITY])
     v_tol = RATE_NOISE_ULPS * EPS * v_scale
     mask = (gap <= gap_tol) & (vn <= v_tol)
     mask[list(always)] = True
@@ -126,10 +127,11 @@ def rest_state(y: np.ndarray, dt: float) -> np.ndarray:
     horizontal drift and the spin about the vertical (untouched by normal impulses)
     carried on for dt."""
     out = np.array(y, dtype=float)
-    out[0:2] += y[7:9] * dt
-    out[9] = 0.0
-    out[10:12] = 0.0
-    out[3:7] = multiply(from_rotation_vector((0.0, 0.0, y[12] * dt)), y[3:7])
+    out[L.X : L.Y + 1] += y[L.VX : L.VY + 1] * dt
+    out[L.VZ] = 0.0
+    out[L.WX : L.WY + 1] = 0.0
+    turn = from_rotation_vector((0.0, 0.0, y[L.WZ] * dt))
+    out[L.QUATERNION] = multiply(turn, y[L.QUATERNION])
     return out
 
 
