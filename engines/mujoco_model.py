@@ -26,7 +26,9 @@ from dataclasses import dataclass
 
 import mujoco
 
-from reference.scene import Scene
+from reference.bumpy import bump_positions, is_bumpy
+from reference.geometry import contact_points
+from reference.scene import Ground, Scene
 
 from .base import scene_points
 
@@ -44,6 +46,12 @@ SPHERE_RADIUS_FRACTION = 1e-3
 # bump deeper than the half-thickness would be pushed out through the top face, so this is
 # also the depth at which engines/mujoco.py declares a fall-through (FALL_THROUGH_DEPTH).
 FACE_HALF_THICKNESS_FRACTION = 0.1
+# Bumpy ground: (contype, conaffinity) of the geoms of each contact kind.  The world's
+# geom (plane or bump) only receives (contype 0), the body's geom only reaches
+# (conaffinity 0), and the two kinds use different bits, so the only pairs MuJoCo
+# collides are vertex–plane (bit 1) and face–bump (bit 2).
+RIM_COLLISION = {"world": (0, 1), "body": (1, 0)}
+BUMP_COLLISION = {"world": (0, 2), "body": (2, 0)}
 
 # MuJoCo's own defaults, written out where the default profile uses them.
 MUJOCO_DEFAULT_TIMECONST = 0.02  # solref[0] default
@@ -182,10 +190,15 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> ContactSettings:
 
 def contact_geom_pairs(scene: Scene) -> list[tuple[str, str]]:
     """(geom1, geom2) names of contact k: vertex k/ground on flat, bump k/face on
-    three_point (the contact numbering of docs/contract.md)."""
+    three_point, both (vertices first) on bumpy (the contact numbering of
+    docs/contract.md)."""
+    rim = [(f"vertex{k}", "ground") for k in range(scene.body.n)]
+    if is_bumpy(scene):
+        m = len(scene.ground.bump_table())
+        return rim + [(f"bump{k}", "face") for k in range(m)]
     if scene.ground.kind == "three_point":
         return [(f"bump{k}", "face") for k in range(3)]
-    return [(f"vertex{k}", "ground") for k in range(scene.body.n)]
+    return rim
 
 
 def _integrator(name: str | None) -> mujoco.mjtIntegrator:
@@ -233,19 +246,14 @@ def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec
     body.mass = scene.body.mass
     body.ipos = [0.0, 0.0, 0.0]
     body.inertia = list(scene.body.inertia_diag)
-    sphere, points = mujoco.mjtGeom.mjGEOM_SPHERE, scene_points(scene)
-    if scene.ground.kind == "three_point":
-        for k, p in enumerate(points):
-            contact_geom(world, f"bump{k}", type=sphere, size=[r, 0, 0], pos=list(p))
-        hh = FACE_HALF_THICKNESS_FRACTION * a
-        contact_geom(
-            body, "face", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[a, hh, 0], pos=[0, 0, r + hh]
-        )
+    if is_bumpy(scene):
+        vertices = contact_points(scene.body, Ground(kind="flat"))
+        _add_rim(world, body, contact_geom, vertices, r, RIM_COLLISION)
+        _add_bumps(world, body, contact_geom, bump_positions(scene.ground, a), a, r, BUMP_COLLISION)
+    elif scene.ground.kind == "three_point":
+        _add_bumps(world, body, contact_geom, scene_points(scene), a, r)
     else:
-        plane = mujoco.mjtGeom.mjGEOM_PLANE
-        contact_geom(world, "ground", type=plane, size=[0, 0, 1], pos=[0, 0, -r])
-        for k, p in enumerate(points):
-            contact_geom(body, f"vertex{k}", type=sphere, size=[r, 0, 0], pos=list(p))
+        _add_rim(world, body, contact_geom, scene_points(scene), r)
     for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
         spec.add_sensor(
             name=f"force{k}",
@@ -258,6 +266,34 @@ def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec
             intprm=[CONTACT_SENSOR_DATA_FORCE, 0, 1],
         )
     return spec
+
+
+def _add_rim(world, body, contact_geom, vertices, r: float, collision=None) -> None:
+    """The floor plane at z = −r and a sphere of radius r at each body-frame vertex."""
+    masks = _masks(collision)
+    plane, sphere = mujoco.mjtGeom.mjGEOM_PLANE, mujoco.mjtGeom.mjGEOM_SPHERE
+    contact_geom(world, "ground", type=plane, size=[0, 0, 1], pos=[0, 0, -r], **masks["world"])
+    for k, p in enumerate(vertices):
+        contact_geom(body, f"vertex{k}", type=sphere, size=[r, 0, 0], pos=list(p), **masks["body"])
+
+
+def _add_bumps(world, body, contact_geom, bumps, a: float, r: float, collision=None) -> None:
+    """A sphere of radius r centred at each world bump and the face: a cylinder of the
+    body's radius whose bottom lies at body height +r."""
+    masks = _masks(collision)
+    sphere = mujoco.mjtGeom.mjGEOM_SPHERE
+    for k, p in enumerate(bumps):
+        contact_geom(world, f"bump{k}", type=sphere, size=[r, 0, 0], pos=list(p), **masks["world"])
+    hh = FACE_HALF_THICKNESS_FRACTION * a
+    cylinder = mujoco.mjtGeom.mjGEOM_CYLINDER
+    contact_geom(body, "face", type=cylinder, size=[a, hh, 0], pos=[0, 0, r + hh], **masks["body"])
+
+
+def _masks(collision) -> dict[str, dict[str, int]]:
+    """MjsGeom attributes for (contype, conaffinity) pairs; none: MuJoCo's defaults."""
+    if collision is None:
+        return {"world": {}, "body": {}}
+    return {side: {"contype": ct, "conaffinity": ca} for side, (ct, ca) in collision.items()}
 
 
 def load_model(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjModel:

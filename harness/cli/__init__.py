@@ -32,6 +32,7 @@ from . import (
     simulate,
     stress,
     sweep,
+    transition,
 )
 from .common import BadInput, Parser, add_verbose, configure_logging
 
@@ -47,6 +48,7 @@ COMMANDS = (
     sweep,
     figures,
     report,
+    transition,
 )
 
 
