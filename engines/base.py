@@ -58,8 +58,8 @@ __all__ = [
 
 
 def scene_points(scene: Scene) -> np.ndarray:
-    """(k, 3) contact points of the scene: body-frame vertices (flat) or world-frame bump
-    centres (three_point), in the scene's contact numbering."""
+    """(k, 3) contact points of the scene (`GroundContacts.points`): body-frame rim
+    vertices, then world floor points, in the scene's contact numbering."""
     return contact_points(scene.body, scene.ground)
 
 
@@ -74,11 +74,12 @@ def contact_kinematics(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np
 
 def effective_contact_mass(scene: Scene) -> float:
     """Mass a unit normal impulse at one contact sees when the body lies flat:
-    1/m_eff = 1/m + |r × n|²/I₁ with |r × n| the lever arm (a for a vertex, b for a bump)
+    1/m_eff = 1/m + |r × n|²/I₁ with |r × n| the lever arm of contact 0
+    (`GroundContacts.lever`: a for a rim vertex, b for a floor point)
     and I₁ = m(ρa)², i.e. m_eff = m/(1 + (r/(ρa))²) (the paper's η/g for a vertex).  For
     the small tilts of these scenes the true value differs by O(α²)."""
     b = scene.body
-    lever = b.radius if scene.ground.kind == "flat" else scene.ground.bump_radius
+    lever = scene.contacts.lever(0)
     return b.mass / (1.0 + (lever / (b.gyration * b.radius)) ** 2)
 
 

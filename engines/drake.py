@@ -69,7 +69,6 @@ from .base import (
     contact_kinematics,
     effective_contact_mass,
     initial_state,
-    scene_points,
     typical_impact_speed,
 )
 
@@ -325,11 +324,11 @@ def build_model(scene: Scene, settings: DrakeSettings) -> DrakeModel:
     on_body = _proximity(k2, d, tau if sap else None)
     on_ground = _proximity(k2, d, 0.0 if sap else None)
     contact_of = {}
-    points = scene_points(scene)
+    contacts = scene.contacts
     world = plant.world_body()
     _quiet_half_space_warning()
-    if scene.ground.kind == "flat":
-        for k, p in enumerate(points):
+    if contacts.has_plane:  # rim vertices: spheres on the body over a half space
+        for k, p in enumerate(contacts.rim_points):
             gid = plant.RegisterCollisionGeometry(
                 body, RigidTransform(p), Sphere(r), f"vertex{k}", on_body
             )
@@ -337,17 +336,17 @@ def build_model(scene: Scene, settings: DrakeSettings) -> DrakeModel:
         plant.RegisterCollisionGeometry(
             world, RigidTransform([0.0, 0.0, -r]), HalfSpace(), "ground", on_ground
         )
-    else:
+    if len(contacts.floor_points):  # floor points: spheres on the ground under a face
         hh = FACE_HALF_THICKNESS_FRACTION * b.radius
         side = 2.0 * b.radius
         plant.RegisterCollisionGeometry(
             body, RigidTransform([0.0, 0.0, r + hh]), Box(side, side, 2 * hh), "face", on_body
         )
-        for k, p in enumerate(points):
+        for j, p in enumerate(contacts.floor_points):
             gid = plant.RegisterCollisionGeometry(
-                world, RigidTransform(p), Sphere(r), f"bump{k}", on_ground
+                world, RigidTransform(p), Sphere(r), f"bump{j}", on_ground
             )
-            contact_of[gid] = k
+            contact_of[gid] = contacts.n_rim + j
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -scene.gravity])
     plant.Finalize()
     return DrakeModel(builder.Build(), plant, body, contact_of, settings)

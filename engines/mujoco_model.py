@@ -26,11 +26,7 @@ from dataclasses import dataclass
 
 import mujoco
 
-from reference.bumpy import bump_positions, is_bumpy
-from reference.geometry import contact_points
-from reference.scene import Ground, Scene
-
-from .base import scene_points
+from reference.scene import Scene
 
 PROFILES = ("tuned", "default")
 # intprm[0] of a contact sensor: the bit set of its data fields; 2 = "force" (the MJCF
@@ -189,16 +185,12 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> ContactSettings:
 
 
 def contact_geom_pairs(scene: Scene) -> list[tuple[str, str]]:
-    """(geom1, geom2) names of contact k: vertex k/ground on flat, bump k/face on
-    three_point, both (vertices first) on bumpy (the contact numbering of
-    docs/contract.md)."""
-    rim = [(f"vertex{k}", "ground") for k in range(scene.body.n)]
-    if is_bumpy(scene):
-        m = len(scene.ground.bump_table())
-        return rim + [(f"bump{k}", "face") for k in range(m)]
-    if scene.ground.kind == "three_point":
-        return [(f"bump{k}", "face") for k in range(3)]
-    return rim
+    """(geom1, geom2) names of contact k: vertex k/ground for a rim vertex, bump j/face
+    for floor point j (the contact numbering of docs/contract.md)."""
+    contacts = scene.contacts
+    return [(f"vertex{k}", "ground") for k in range(contacts.n_rim)] + [
+        (f"bump{j}", "face") for j in range(len(contacts.floor_points))
+    ]
 
 
 def _integrator(name: str | None) -> mujoco.mjtIntegrator:
@@ -246,14 +238,14 @@ def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec
     body.mass = scene.body.mass
     body.ipos = [0.0, 0.0, 0.0]
     body.inertia = list(scene.body.inertia_diag)
-    if is_bumpy(scene):
-        vertices = contact_points(scene.body, Ground(kind="flat"))
-        _add_rim(world, body, contact_geom, vertices, r, RIM_COLLISION)
-        _add_bumps(world, body, contact_geom, bump_positions(scene.ground, a), a, r, BUMP_COLLISION)
-    elif scene.ground.kind == "three_point":
-        _add_bumps(world, body, contact_geom, scene_points(scene), a, r)
-    else:
-        _add_rim(world, body, contact_geom, scene_points(scene), r)
+    contacts = scene.contacts
+    # both kinds on one ground (bumpy): bit masks keep each body geom to its own partner
+    both = contacts.has_plane and len(contacts.floor_points) > 0
+    if len(contacts.floor_points):  # floor points: spheres on the ground under a face
+        masks = BUMP_COLLISION if both else None
+        _add_bumps(world, body, contact_geom, contacts.floor_points, a, r, masks)
+    if contacts.has_plane:  # rim vertices: spheres on the body over a plane
+        _add_rim(world, body, contact_geom, contacts.rim_points, r, RIM_COLLISION if both else None)
     for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
         spec.add_sensor(
             name=f"force{k}",

@@ -103,8 +103,9 @@ class Handles:
 def body_urdf(scene: Scene, sphere_radius: float) -> str:
     """URDF of the body: inertial frame = link frame (centre of mass, principal axes),
     mass m, inertia m(ρa)² diag(1, 1, 2); collisions: a sphere at every vertex
-    a(cos 2πk/n, sin 2πk/n, 0) on flat ground, or a thin box whose bottom face is the
-    mid-plane z = 0 on three_point ground.  Numbers are written as plain floats."""
+    a(cos 2πk/n, sin 2πk/n, 0) for the rim vertices of a ground, and a thin box whose
+    bottom face is the mid-plane z = 0 for its floor points
+    (reference.contact_kinds).  Numbers are written as plain floats."""
     b = scene.body
     i1, i2, i3 = b.inertia_diag
 
@@ -121,17 +122,15 @@ def body_urdf(scene: Scene, sphere_radius: float) -> str:
         f'      <inertia ixx="{f(i1)}" ixy="0" ixz="0" iyy="{f(i2)}" iyz="0" izz="{f(i3)}"/>',
         "    </inertial>",
     ]
-    if scene.ground.kind == "flat":
-        for k in range(b.n):
-            ang = 2.0 * math.pi * k / b.n
-            x, y = b.radius * math.cos(ang), b.radius * math.sin(ang)
-            lines += [
-                "    <collision>",
-                f'      <origin xyz="{f(x)} {f(y)} 0" rpy="0 0 0"/>',
-                f'      <geometry><sphere radius="{f(sphere_radius)}"/></geometry>',
-                "    </collision>",
-            ]
-    else:
+    contacts = scene.contacts
+    for x, y, _ in contacts.rim_points:  # rim vertices: spheres on the body
+        lines += [
+            "    <collision>",
+            f'      <origin xyz="{f(x)} {f(y)} 0" rpy="0 0 0"/>',
+            f'      <geometry><sphere radius="{f(sphere_radius)}"/></geometry>',
+            "    </collision>",
+        ]
+    if len(contacts.floor_points):  # floor points: touch the body's face
         h = FACE_THICKNESS * b.radius
         side = 2.0 * b.radius  # a square face that covers the disk
         lines += [
@@ -175,7 +174,7 @@ def _engine_parameters(scene: Scene, dt: float, profile: str) -> dict:
         # flickers: 516 instead of 78 onsets in 1 s of the three-point-disk scene), so
         # Bullet's default is kept.  Global to the process (see the default profile).
         contactBreakingThreshold=(
-            _breaking_threshold(scene, dt) if scene.ground.kind == "flat" else 0.02
+            _breaking_threshold(scene, dt) if scene.contacts.rim_only else 0.02
         ),
         # Split impulse: penetration is removed by a separate pseudo-velocity, so the
         # position correction adds no velocity (no energy) to the bounce.  Threshold 0:
@@ -244,6 +243,8 @@ def build_world(scene: Scene, dt: float, profile: str = "tuned") -> Handles:
     The caller owns the client and must `pybullet.disconnect(handles.client)`."""
     if profile not in PROFILES:
         raise ValueError(f"unknown PyBullet profile {profile!r}; choose from {PROFILES}")
+    if not (scene.contacts.rim_only or not scene.contacts.has_plane):
+        raise ValueError("the PyBullet adapter builds a ground of one contact kind only")
     client = pb.connect(pb.DIRECT)
     try:
         return _build(client, scene, dt, profile)
@@ -278,7 +279,7 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
         )
     pb.resetBaseVelocity(body, [float(v) for v in y0[7:10]], [float(v) for v in y0[10:13]], **cid)
 
-    if scene.ground.kind == "flat":
+    if scene.contacts.rim_only:
         plane = pb.createCollisionShape(pb.GEOM_PLANE, **cid)
         ground = (
             pb.createMultiBody(
@@ -287,20 +288,15 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
         )
     else:
         bump = pb.createCollisionShape(pb.GEOM_SPHERE, radius=r, **cid)
-        b = scene.ground.bump_radius
         ground = tuple(
             pb.createMultiBody(
                 0.0,
                 bump,
-                basePosition=[
-                    b * math.cos(2 * math.pi * k / 3),
-                    b * math.sin(2 * math.pi * k / 3),
-                    -r,
-                ],
+                basePosition=[float(x), float(y), -r],
                 useMaximalCoordinates=maximal,
                 **cid,
             )
-            for k in range(3)
+            for x, y, _ in scene.contacts.floor_points
         )
 
     e_body, e_ground = _restitutions(scene)
@@ -356,7 +352,7 @@ def contact_forces(h: Handles, scene: Scene) -> np.ndarray:
     y = read_state(h)
     for cp in pb.getContactPoints(bodyA=h.body, physicsClientId=h.client):
         if cp[9] > 0.0 and cp[8] <= h.processing_threshold:
-            if scene.ground.kind == "flat":
+            if scene.contacts.rim_only:
                 k = _contact_index_flat(np.array([cp[5]]), y[0:3], y[3:7], scene.body.n)[0]
             else:
                 k = ground_index[cp[2]]
@@ -399,8 +395,8 @@ def simulate_pybullet(
     if sample_every is None:
         time_unit = math.sqrt(a / scene.gravity) if scene.gravity > 0 else 1.0
         sample_every = max(1, min(n_steps, int(1e-3 * time_unit / dt)))
-    flat = scene.ground.kind == "flat"
-    n_contacts = scene.n_contacts
+    flat = scene.contacts.rim_only  # (else floor points: a ground of rim vertices alone or
+    n_contacts = scene.n_contacts  # of floor points alone, `build_world`)
 
     setup0 = time.perf_counter()
     h = build_world(scene, dt, profile)

@@ -131,12 +131,12 @@ def _first_below(
     scene: Scene, states: np.ndarray, depth: float, stop: int | None
 ) -> tuple[int, float, int] | None:
     """(row, gap, contact) of the first row (before `stop`) with a contact gap below
-    `depth`.  On flat ground the lowest point of the body's circumcircle,
+    `depth`.  On a ground of rim vertices alone the lowest point of the body's circumcircle,
     z − a |(e3x, e3y)|, bounds every vertex gap from below, so only rows where that
     bound dips below `depth` need the exact gaps (reference.geometry): O(rows) for any n
     in a sane run."""
     rows = states[:stop] if stop is not None else states
-    if scene.ground.kind == "flat":
+    if scene.contacts.rim_only:
         e3 = qt.body_axis(qt.normalize(rows[:, 3:7]))
         bound = rows[:, 2] - scene.body.radius * np.hypot(e3[:, 0], e3[:, 1])
         candidates = np.flatnonzero(bound < depth)

@@ -4,14 +4,14 @@ scene validation, the engine adapters, the metrics and the recordings.
 State rows (13): position x (3), quaternion q = (w, x, y, z) body → world (4),
 velocity v (3), angular velocity ω in the world frame (3).
 
-Contacts (the model of Baranyai & Várkonyi, section 2):
-- `flat`: contact k is vertex k, body-frame position a(cos 2πk/n, sin 2πk/n, 0); with
+Contacts (the model of Baranyai & Várkonyi, section 2; reference.contact_kinds):
+- a rim vertex on the plane: body-frame position p_k = a(cos 2πk/n, sin 2πk/n, 0); with
   r_k = R p_k its gap is z + (r_k)_z (the z row of R from the small quaternion
   components directly, so tilts of 1e-12 keep their digits) and its normal
   velocity v_z + (ω × r_k)_z;
-- `three_point`: contact k is the ground bump b_k = b(cos 2πk/3, sin 2πk/3, 0); the
-  body's face (the plane through the centre of mass with normal e3 = R ẑ) touches it:
-  gap (x − b_k)·e3, normal velocity v·e3 − (ω × (x − b_k))·e3.
+- a floor point on the face: the fixed point b_k (`three_point`: b(cos 2πk/3,
+  sin 2πk/3, 0)); the body's face (the plane through the centre of mass with normal
+  e3 = R ẑ) touches it: gap (x − b_k)·e3, normal velocity v·e3 − (ω × (x − b_k))·e3.
 
 The formulas are the compiled core's (reference.core.contacts, reference.core.inertia),
 applied row by row (reference.core.arrays).
@@ -19,7 +19,6 @@ applied row by row (reference.core.arrays).
 
 from __future__ import annotations
 
-import functools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -28,24 +27,14 @@ from .compiled import function
 from .quaternion import from_rotation_vector
 
 if TYPE_CHECKING:  # geometry depends on no other module of the package
+    from .contact_kinds import GroundContacts
     from .scene import Body, Ground, InitialState, Scene
 
 
 def contact_points(body: Body, ground: Ground) -> np.ndarray:
-    """(k, 3): body-frame vertices (flat ground) or world bump positions (three_point);
-    read-only, shared between calls with the same geometry."""
-    if ground.kind == "flat":
-        return _regular_points(body.n, body.radius)
-    return _regular_points(3, ground.bump_radius)
-
-
-@functools.lru_cache(maxsize=64)
-def _regular_points(k: int, r: float) -> np.ndarray:
-    """(k, 3): r (cos 2πi/k, sin 2πi/k, 0), read-only."""
-    ang = 2.0 * np.pi * np.arange(k) / k
-    pts = r * np.stack([np.cos(ang), np.sin(ang), np.zeros(k)], axis=1)
-    pts.setflags(write=False)
-    return pts
+    """(k, 3): the ground's contact points (`Ground.contacts`): body-frame rim vertices,
+    then world floor points; read-only, shared between calls with the same geometry."""
+    return ground.contacts(body).points
 
 
 def initial_state(initial: InitialState) -> np.ndarray:
@@ -63,21 +52,19 @@ def _states(states: np.ndarray) -> np.ndarray:
 
 
 def contact_kinematics(
-    states: np.ndarray, points: np.ndarray, flat: bool
+    states: np.ndarray, contacts: GroundContacts
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Gap and normal velocity (N, k) of every contact for states (N, 13)."""
+    """Gap and normal velocity (N, k) of every contact of a ground for states (N, 13)."""
     S = _states(states)
-    pts = np.ascontiguousarray(points, dtype=float)
+    pts = np.ascontiguousarray(contacts.points, dtype=float)
     gap, vn = np.empty((len(S), len(pts))), np.empty((len(S), len(pts)))
-    function("contact_kinematics_rows")(S, pts, bool(flat), gap, vn)
+    function("contact_kinematics_rows")(S, pts, contacts.n_rim, gap, vn)
     return gap, vn
 
 
 def scene_contact_kinematics(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """`contact_kinematics` with the scene's contact points and ground."""
-    return contact_kinematics(
-        states, contact_points(scene.body, scene.ground), scene.ground.kind == "flat"
-    )
+    """`contact_kinematics` with the scene's ground's contacts."""
+    return contact_kinematics(states, scene.contacts)
 
 
 def _energy_rows(scene: Scene, states: np.ndarray) -> np.ndarray:
@@ -85,8 +72,8 @@ def _energy_rows(scene: Scene, states: np.ndarray) -> np.ndarray:
     S = _states(states)
     i1, _, i3 = scene.body.inertia_diag
     out = np.empty((len(S), 3))
-    flat = scene.ground.kind == "flat"
-    function("energy_rows")(S, flat, scene.body.mass, i1, i3, scene.gravity, out)
+    keeps = scene.contacts.invariants
+    function("energy_rows")(S, keeps, scene.body.mass, i1, i3, scene.gravity, out)
     return out
 
 
@@ -98,8 +85,9 @@ def energies(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def excess_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
-    """(N,) energy above the lowest level the invariants allow (the level the motion ends
-    at: flat ground E − ½ m |v_h|² − L_z²/(2 I3), three-point E − ½ I3 ω3²): the E of
+    """(N,) energy above the lowest level the ground's invariants allow (the level the
+    motion ends at: rim vertices on the plane E − ½ m |v_h|² − L_z²/(2 I3), floor points
+    on the face E − ½ I3 ω3², `GroundContacts.invariants`): the E of
     the paper's E ≈ a (t_f − t)^c, which goes to zero at the end of the motion."""
     return _energy_rows(scene, states)[:, 2]
 

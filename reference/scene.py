@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from .contact_kinds import GroundContacts, ground_contacts
 from .geometry import initial_state, scene_contact_kinematics
 from .quaternion import body_axis
 
@@ -81,10 +82,25 @@ class Body:
 
 @dataclass(frozen=True)
 class Ground:
-    """`flat`: the plane z = 0.  `three_point`: bumps at (b cos 2πk/3, b sin 2πk/3, 0)."""
+    """The scene file's [ground]: `flat`, the plane z = 0 that the body's rim vertices
+    touch; `three_point`, floor points (bumps) at (b cos 2πk/3, b sin 2πk/3, 0) that
+    touch the body's face.  `contacts` turns it into the list of contacts of kinds
+    (reference.contact_kinds) that everything else reads."""
 
     kind: str = "flat"
     bump_radius: float = 0.5
+
+    def contacts(self, body: Body) -> GroundContacts:
+        """The ground's contacts for this body: `flat`, its n rim vertices on the plane;
+        `three_point`, three floor points on its face."""
+        if self.kind == "three_point":
+            return ground_contacts(0, body.radius, 3, self.bump_radius)
+        return ground_contacts(body.n, body.radius, 0, self.bump_radius)
+
+    @property
+    def name(self) -> str:
+        """The ground's name in text: 'flat', 'three-point'."""
+        return self.kind.replace("_", "-")
 
 
 @dataclass(frozen=True)
@@ -118,8 +134,13 @@ class Scene:
     run: RunSettings = field(default_factory=RunSettings)
 
     @property
+    def contacts(self) -> GroundContacts:
+        """The ground's contacts for the scene's body (`Ground.contacts`)."""
+        return self.ground.contacts(self.body)
+
+    @property
     def n_contacts(self) -> int:
-        return 3 if self.ground.kind == "three_point" else self.body.n
+        return self.contacts.n
 
     def with_run(self, **changes: Any) -> Scene:
         """The scene with other run settings, checked like a scene file's [run]
@@ -367,8 +388,8 @@ def check_not_below_ground(scene: Scene) -> None:
         raise SceneError(
             f"the body starts below the ground: contact {worst} is at gap {gaps[worst]:.3g}"
         )
-    if scene.ground.kind == "three_point" and body_axis(y0[3:7])[2] <= 0.0:
-        raise SceneError("three_point ground needs the body's face normal pointing up")
+    if len(scene.contacts.floor_points) and body_axis(y0[3:7])[2] <= 0.0:
+        raise SceneError(f"{scene.ground.kind} ground needs the body's face normal pointing up")
 
 
 def _table(name: str, data: dict) -> dict:

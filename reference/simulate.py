@@ -122,7 +122,7 @@ def _grown(arr: np.ndarray, rows: int) -> np.ndarray:
 def model_record(scene: Scene) -> np.ndarray:
     """The body, ground and impact law as the core reads them."""
     i1, _, i3 = scene.body.inertia_diag
-    flat = scene.ground.kind == "flat"
+    contacts = scene.contacts
     rec = np.zeros(1, dtype=R.MODEL)
     rec["mass"], rec["i1"], rec["i3"] = scene.body.mass, i1, i3
     rec["radius"], rec["gravity"], rec["gamma"] = (
@@ -130,10 +130,11 @@ def model_record(scene: Scene) -> np.ndarray:
         scene.gravity,
         scene.restitution,
     )
-    rec["flat_ground"] = flat
-    rec["n_contacts"] = scene.n_contacts
+    rec["n_contacts"] = contacts.n
+    rec["n_rim"] = contacts.n_rim
+    rec["invariants"] = contacts.invariants
     rec["sag"] = 1.0 - math.cos(math.pi / scene.body.n)
-    rec["all_down"] = 2 if flat and scene.body.n == 2 else 3
+    rec["all_down"] = contacts.all_down
     return rec
 
 

@@ -48,7 +48,7 @@ def test_gap_jets_equal_the_oracles_array_expressions(ground, n):
         acc = tuple(float(a) for a in rng.normal(0, 1, 6))
         ref = gap_jet(oracle, y, np.array(acc))
         for k in range(len(pts)):
-            j = contact_jet(y, bool(model["flat_ground"]), pts, k, acc)
+            j = contact_jet(y, scene.contacts.kind(k), pts, k, acc)
             assert abs(j.gap - ref.gap[k]) <= 4e-16
             assert abs(j.rate - ref.rate[k]) <= 1e-14
             assert abs(j.accel - ref.accel[k]) <= 1e-13

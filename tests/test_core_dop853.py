@@ -14,6 +14,7 @@ from reference.core import dop853_tableau as tab
 from reference.core.contacts import contact_frame, vertex_lever
 from reference.core.dop853 import INT_CROSSING, INT_DONE, integrate_held
 from reference.core.held import held_rhs, new_work
+from reference.core.records import RIM_VERTEX_ON_PLANE
 from tests.conftest import core_model, empty_output, make_scene
 
 
@@ -99,7 +100,7 @@ def test_crossing_is_located_where_scipys_event_finds_it():
 
     def gap_event(k):
         def gap(_t, y):
-            return contact_frame(np.ascontiguousarray(y), model["flat_ground"], pts, k).gap
+            return contact_frame(np.ascontiguousarray(y), RIM_VERTEX_ON_PLANE, pts, k).gap
 
         gap.terminal, gap.direction = True, -1
         return gap
@@ -118,7 +119,7 @@ def test_crossing_is_located_where_scipys_event_finds_it():
     )  # fmt: skip
     assert r.status == INT_CROSSING
     assert abs(r.s - t_ref) < 1e-10
-    assert abs(contact_frame(y, model["flat_ground"], pts, first[0]).gap) < 1e-12
+    assert abs(contact_frame(y, RIM_VERTEX_ON_PLANE, pts, first[0]).gap) < 1e-12
 
 
 def test_heun_euler_step_is_the_motion_to_roundoff_on_a_short_step_and_rejects_a_long_one():

@@ -15,6 +15,7 @@ from reference.core.flight import (
     free_flight,
     vertex_height_bounds,
 )
+from reference.core.records import RIM_VERTEX_ON_PLANE
 from reference.geometry import energies
 from tests.conftest import core_model, make_scene
 from tests.oracle.body import BodyModel
@@ -157,7 +158,7 @@ def test_vertex_height_bounds_hold_for_every_vertex_over_long_flights(seed):
         acc = np.empty((len(ts), len(pts)))
         for i, y in enumerate(states):
             a = flight_acceleration(fc, y, 1.0)
-            acc[i] = [contact_jet(y, True, pts, k, a).accel for k in range(len(pts))]
+            acc[i] = [contact_jet(y, RIM_VERTEX_ON_PLANE, pts, k, a).accel for k in range(len(pts))]
         assert np.abs(acc).max() <= K
         assert np.abs(np.diff(acc, axis=0) / (ts[1] - ts[0])).max() <= B * (1 + 1e-3) + 1e-12
 

@@ -10,7 +10,7 @@ from harness.scenes import resolve_scene
 from reference import ReferenceOptions, simulate
 from reference import quaternion as qt
 from reference.core.flight import flight_bounds, flight_constants
-from reference.core.records import EVENT_IMPACT, EVENT_NONE
+from reference.core.records import EVENT_IMPACT, EVENT_NONE, RIM_VERTEX_ON_PLANE
 from reference.core.search import find_flight_event
 from reference.geometry import initial_state
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
@@ -176,7 +176,7 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
         examine_range(y, acc, jet, pts, 64, bounds.K, bounds.B, 0, 64, 1e-14, res, 1.0)
         alone = []
         for k in range(64):
-            j = contact_jet(y, True, pts, k, acc)
+            j = contact_jet(y, RIM_VERTEX_ON_PLANE, pts, k, acc)
             alone.append(safe_step(j.gap, j.rate, j.accel, bounds.K, bounds.B))
         order = np.argsort(alone)
         least = alone[order[0]]
@@ -268,7 +268,7 @@ def test_others_safe_time_ends_before_any_other_contact_reaches_the_ground():
         y[2] -= gaps(scene, y)[k]  # vertex k at the ground
         fc = flight_constants(y, i1, i3)
         acc = flight_acceleration(fc, y, scene.gravity)
-        j = contact_jet(y, True, pts, k, acc)
+        j = contact_jet(y, RIM_VERTEX_ON_PLANE, pts, k, acc)
         y[9] += 0.3 - j.rate  # vertex k moving away at 0.3
         fc = flight_constants(y, i1, i3)
         acc = flight_acceleration(fc, y, scene.gravity)
@@ -348,8 +348,10 @@ def test_bracketed_newton_stops_at_the_zero_instead_of_alternating_between_its_e
             calls.clear()
             y = np.empty(13)
             x0 = lo if rng.uniform() < 0.5 else rng.uniform(lo, hi)  # (its start)
-            x = newton(y0, fc, scene.gravity, True, pts, e.contact, lo, hi, x0, y)
-            jet = contact_jet(y, True, pts, e.contact, flight_acceleration(fc, y, scene.gravity))
+            x = newton(y0, fc, scene.gravity, RIM_VERTEX_ON_PLANE, pts, e.contact, lo, hi, x0, y)
+            jet = contact_jet(
+                y, RIM_VERTEX_ON_PLANE, pts, e.contact, flight_acceleration(fc, y, scene.gravity)
+            )
             assert len(calls) <= 16
             assert lo < x < hi and abs(jet.gap) <= jet.noise
 

@@ -45,10 +45,10 @@ def _num(x: float | None, fmt: str = ".1e") -> str:
 
 
 def contact_name(scene: Scene, k: int | None) -> str:
-    """'v2' (vertex 2, flat ground) or 'b2' (bump 2, three_point ground)."""
+    """'v2' (rim vertex 2) or 'b2' (floor point 2): `GroundContacts.label`."""
     if k is None:
         return "?"
-    return f"{'v' if scene.ground.kind == 'flat' else 'b'}{int(k)}"
+    return scene.contacts.label(int(k))
 
 
 def impacts_cell(m) -> str:
@@ -143,7 +143,7 @@ def _header(result: CompareResult) -> list[str]:
     body = scene.body
     shape = "rod" if body.n == 2 else f"{body.n}-gon"
     head = (
-        f"{scene.name}: {shape} on {scene.ground.kind.replace('_', '-')} ground, "
+        f"{scene.name}: {shape} on {scene.ground.name} ground, "
         f"ρ = {body.gyration:g}, γ = {scene.restitution:g}, g = {scene.gravity:g}"
     )
     text = (

@@ -73,8 +73,9 @@ def ground_square(half_width: float, z: float = 0.0) -> tuple[np.ndarray, np.nda
 
 
 def bump_positions(scene: Scene) -> np.ndarray:
-    """World positions (3, 3) of the three bumps' tips (reference.geometry.contact_points)."""
-    return np.array(G.contact_points(scene.body, scene.ground))
+    """World positions (m, 3) of the ground's floor points, the bumps' tips
+    (`GroundContacts.floor_points`)."""
+    return np.array(scene.contacts.floor_points)
 
 
 def pose_states(position: np.ndarray, quaternion_wxyz: np.ndarray) -> np.ndarray:
@@ -92,16 +93,16 @@ def contact_points(
     """World positions (N, k, 3) of the contact points and their gaps (N, k), gaps from
     reference.geometry.scene_contact_kinematics.
 
-    flat: the vertices, x + R r_k (gap = their height); three_point: the point of the
-    face above bump k, b_k + gap_k e3."""
+    A rim vertex: x + R r_k (gap = its height); a floor point: the point of the face
+    above it, b_k + gap_k e3."""
     x = np.asarray(position, dtype=float)
     q = np.asarray(quaternion_wxyz, dtype=float)
     gap, _ = G.scene_contact_kinematics(scene, pose_states(x, q))
     pts = np.array(G.contact_points(scene.body, scene.ground))
-    if scene.ground.kind == "flat":
-        world = x[:, None, :] + qt.rotate(q[:, None, :], pts[None, :, :])
-    else:
-        world = pts[None, :, :] + gap[:, :, None] * qt.body_axis(q)[:, None, :]
+    n_rim = scene.contacts.n_rim
+    rim = x[:, None, :] + qt.rotate(q[:, None, :], pts[None, :n_rim, :])
+    floor = pts[None, n_rim:, :] + gap[:, n_rim:, None] * qt.body_axis(q)[:, None, :]
+    world = np.concatenate([rim, floor], axis=1)
     return world, gap
 
 
@@ -172,7 +173,7 @@ def exaggerated_pose(
     x0 = x.copy()
     x0[:, 2] = 0.0
     gap0, _ = G.scene_contact_kinematics(scene, pose_states(x0, q2))
-    slope = 1.0 if scene.ground.kind == "flat" else qt.body_axis(q2)[:, 2]
+    slope = 1.0 if scene.contacts.rim_only else qt.body_axis(q2)[:, 2]
     x2 = x.copy()
     x2[:, 2] = (factor * gap.min(axis=1) - gap0.min(axis=1)) / slope
     return x2, q2

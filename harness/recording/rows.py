@@ -217,7 +217,7 @@ def _log_static_scene(
         rr.Mesh3D(vertex_positions=verts, triangle_indices=tris, albedo_factor=(70, 70, 70)),
         static=True,
     )
-    if scene.ground.kind == "three_point":
+    if len(scene.contacts.floor_points):
         r = 0.04 * a
         bumps = bump_positions(scene) - np.array([0.0, 0.0, r])  # tips at z = 0
         rec.log(
@@ -246,7 +246,7 @@ def _log_static_scene(
         rr.Arrows3D(vectors=[[0.0, 0.0, 0.5 * a]], colors=[color], radii=[0.008 * a]),
         static=True,
     )
-    labels = [str(k) for k in range(n)] if scene.ground.kind == "flat" and n <= 12 else None
+    labels = [str(k) for k in range(n)] if scene.contacts.has_plane and n <= 12 else None
     rec.log(
         f"{root}/disk/vertices",
         rr.Points3D(

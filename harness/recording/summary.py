@@ -16,7 +16,7 @@ def _scene_line(scene: Scene, t_max: float, t_ref: float) -> str:
     shape = "rod" if b.n == 2 else f"{b.n}-gon"
     why = " (the reference's end + 10 %)" if t_max > t_ref else ""
     return (
-        f"{shape} on {scene.ground.kind.replace('_', '-')} ground, ρ = {b.gyration:g}, "
+        f"{shape} on {scene.ground.name} ground, ρ = {b.gyration:g}, "
         f"γ = {scene.restitution:g}, g = {scene.gravity:g}; recorded to t = {t_max:.4g} s"
         f"{why}."
     )

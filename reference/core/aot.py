@@ -27,7 +27,7 @@ def signatures() -> dict:
     f2 = types.Array(types.float64, 2, "C")
     f1 = types.Array(types.float64, 1, "C")
     i2 = types.Array(types.int64, 2, "C")
-    f8, b1, void = types.float64, types.boolean, types.void
+    f8, i8, void = types.float64, types.int64, types.void
     return {
         "run_events": types.int64(rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2),
         "quaternion_product_rows": void(f2, f2, f2),
@@ -36,8 +36,8 @@ def signatures() -> dict:
         "rotate_rows": void(f2, f2, f2),
         "tilt_rows": void(f2, f1),
         "axis_rows": void(f2, f2),
-        "contact_kinematics_rows": void(f2, f2, b1, f2, f2),
-        "energy_rows": void(f2, b1, f8, f8, f8, f8, f2),
+        "contact_kinematics_rows": void(f2, f2, i8, f2, f2),
+        "energy_rows": void(f2, i8, f8, f8, f8, f8, f2),
         "free_acceleration_rows": void(f2, f8, f8, f8, f2),
         "length_scale_rows": void(f2, f8, f1),
     }

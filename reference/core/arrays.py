@@ -8,6 +8,7 @@ from numba import njit
 
 from .contacts import contact_frame, length_scale, normal_velocity
 from .inertia import excess_energy, free_acceleration, kinetic_energy, potential_energy
+from .records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE
 from .rotation import (
     axis_of,
     qmul,
@@ -61,24 +62,26 @@ def axis_rows(q, out):
 
 
 @njit(cache=True)
-def contact_kinematics_rows(states, pts, flat, gap, vn):
-    """gap[i, k] and vn[i, k]: gap and normal velocity of contact k at state i."""
+def contact_kinematics_rows(states, pts, n_rim, gap, vn):
+    """gap[i, k] and vn[i, k]: gap and normal velocity of contact k at state i (the
+    ground's contacts: n_rim rim vertices, then floor points, `contacts.contact_kind`)."""
     for i in range(states.shape[0]):
         y = states[i]
         for k in range(pts.shape[0]):
-            f = contact_frame(y, flat, pts, k)
+            kind = RIM_VERTEX_ON_PLANE if k < n_rim else FLOOR_POINT_ON_FACE
+            f = contact_frame(y, kind, pts, k)
             gap[i, k] = f.gap
-            vn[i, k] = normal_velocity(y, f, flat)
+            vn[i, k] = normal_velocity(y, f, kind)
 
 
 @njit(cache=True)
-def energy_rows(states, flat, mass, i1, i3, gravity, out):
+def energy_rows(states, invariants, mass, i1, i3, gravity, out):
     """out[i] = (kinetic, potential, excess) energy of state i."""
     for i in range(states.shape[0]):
         y = states[i]
         out[i, 0] = kinetic_energy(y, mass, i1, i3)
         out[i, 1] = potential_energy(y, mass, gravity)
-        out[i, 2] = excess_energy(y, flat, mass, i1, i3, gravity)
+        out[i, 2] = excess_energy(y, invariants, mass, i1, i3, gravity)
 
 
 @njit(cache=True)

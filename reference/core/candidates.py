@@ -13,7 +13,7 @@ with n."""
 import math
 from collections import namedtuple
 
-from .contacts import contact_jet, rim_jet, vertex_gap_noise
+from .contacts import contact_jet, contact_kind, rim_jet, vertex_gap_noise
 from .horizon import horizon_bound, local_time_cap, safe_horizon
 from .jit import hot
 from .roots import quadratic_taylor_root
@@ -50,7 +50,7 @@ def _list_free(state, cs, first, count, n, m):
 def _jets(y, model, pts, acc, cs, i0, i1):
     """Jets of cs.cand[i0:i1] with the held acceleration acc."""
     for i in range(i0, i1):
-        j = contact_jet(y, model.flat_ground, pts, cs.cand[i], acc)
+        j = contact_jet(y, contact_kind(model, cs.cand[i]), pts, cs.cand[i], acc)
         cs.gap[i], cs.rate[i], cs.accel[i], cs.noise[i] = j.gap, j.rate, j.accel, j.noise
 
 
@@ -61,7 +61,7 @@ def touching_candidates(state, model, pts, opts, acc, cs, touch):
     side.  Returns Examined."""
     y = state.y
     n = pts.shape[0]
-    if not use_window(model, opts.window_search, n):
+    if not use_window(model, opts.window_search):
         m = _list_free(state, cs, 0, n, n, 0)
         _jets(y, model, pts, acc, cs, 0, m)
         acc_scale = 0.0

@@ -11,7 +11,7 @@ by O((u/V)²) relative: chatter_tol² = 1e-12 for the default chatter_tol = 1e-6
 
 import math
 
-from .contacts import contact_frame, velocity_scale
+from .contacts import contact_frame, contact_kind, velocity_scale
 from .impact import bounce_ratio
 from .jit import hot
 from .tolerances import CHATTER_BOUNCE_FLOOR, TINY
@@ -26,7 +26,7 @@ def completion_speed(y, model, pts, k, chatter_tol, vnoise):
     if bounce_ratio(model.gamma) >= 1.0:
         return vnoise
     small = chatter_tol * velocity_scale(y, model.radius)
-    noise = contact_frame(y, model.flat_ground, pts, k).noise
+    noise = contact_frame(y, contact_kind(model, k), pts, k).noise
     a_scale = model.gravity + model.radius * (y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
     return max(small, CHATTER_BOUNCE_FLOOR * math.sqrt(2.0 * a_scale * noise), vnoise)
 

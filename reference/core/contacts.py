@@ -1,22 +1,38 @@
-"""Contact geometry for one state (the model of Baranyai & Várkonyi, section 2):
+"""The contact kinds: the geometry of one contact at a state (the model of Baranyai &
+Várkonyi, section 2).  A ground is a list of contacts, each of a kind
+(`records.RIM_VERTEX_ON_PLANE`, `records.FLOOR_POINT_ON_FACE`): its rim vertices first,
+contacts 0 … model.n_rim − 1, then its floor points (`contact_kind`).  `pts[k]` is
+contact k's point: body-frame for a rim vertex, world for a floor point.
 
-- flat ground: contact k is vertex k at body position p_k = a(cos 2πk/n, sin 2πk/n, 0);
-  lever r = R p_k, gap g = z + r_z, normal n = e_z (paper eq. rig, exact in α);
-- three-point ground: contact k is the bump b_k = b(cos 2πk/3, sin 2πk/3, 0) under the
-  body's face (normal e3 = R ẑ through the centre of mass): with d = x − b_k, gap
-  g = d·e3, normal n = e3, lever r = −d + g e3 (the in-plane part of b_k − x).
+- RIM_VERTEX_ON_PLANE: the body point p_k = a(cos 2πk/n, sin 2πk/n, 0) against the
+  plane z = 0; lever r = R p_k, gap g = z + r_z, normal n = e_z (paper eq. rig, exact
+  in α);
+- FLOOR_POINT_ON_FACE: the fixed world point b_k under the body's face (normal
+  e3 = R ẑ through the centre of mass): with d = x − b_k, gap g = d·e3, normal
+  n = e3, lever r = −d + g e3 (the in-plane part of b_k − x); the model has no such
+  contact once the point is outside the face's rim (`off_face`).
 
 Either way the normal velocity is g′ = n·(v + ω × r) and the normal acceleration is
-g″ = J (v̇, ω̇) + bias with J = [nᵀ, (r × n)ᵀ] (paper eq. rollc).  `pts` holds the
-body-frame vertices (flat) or the world bumps (three-point).  Accelerations `acc` are
-tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
+g″ = J (v̇, ω̇) + bias with J = [nᵀ, (r × n)ᵀ] (paper eq. rollc); the impulse response
+is the kind-free `inertia.impulse_response` of the frame.  Each function below takes
+the contact's kind and branches on it, the only place the core asks for it; the
+derivative bounds of the event search per kind are in reference.core.flight, and the
+circle step and vertex windows of the rim vertices in reference.core.rim and window.
+Accelerations `acc` are tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
 
 import math
 
 from .jit import hot
-from .records import Frame, Jet
+from .records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE, Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
 from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTOR, TINY
+
+
+@hot
+def contact_kind(model, k):
+    """The kind of the ground's contact k: its rim vertices come first (model.n_rim of
+    them), its floor points after."""
+    return RIM_VERTEX_ON_PLANE if k < model.n_rim else FLOOR_POINT_ON_FACE
 
 
 @hot
@@ -62,30 +78,30 @@ def bump_frame(y, bx, by, bz):
 
 
 @hot
-def contact_frame(y, flat, pts, k):
-    """Gap, normal, lever and gap roundoff of contact k at state y."""
-    if flat:
+def contact_frame(y, kind, pts, k):
+    """Gap, normal, lever and gap roundoff of contact k (of kind `kind`) at state y."""
+    if kind == RIM_VERTEX_ON_PLANE:
         return vertex_frame(y, rotation_columns_xy(y), pts[k, 0], pts[k, 1])
     return bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
 @hot
 def off_face(y, model, pts, k):
-    """Whether contact k meets the face's plane outside its rim, |lever| > a: on the
-    three-point ground a bump beside the body, not under it (the model's contact does
-    not exist there: the body has left the bumps).  Never on flat ground, whose contacts
-    are the vertices themselves."""
-    if model.flat_ground:
+    """Whether contact k has left the model: a floor point meeting the face's plane
+    outside its rim, |lever| > a, beside the body, not under it (the model's contact
+    does not exist there: the body has left the bumps).  Never a rim vertex, a point of
+    the body itself."""
+    if contact_kind(model, k) == RIM_VERTEX_ON_PLANE:
         return False
     f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
     return f.rx * f.rx + f.ry * f.ry + f.rz * f.rz > model.radius * model.radius
 
 
 @hot
-def normal_velocity(y, f, flat):
-    """g′ = n·(v + ω × r) of the contact with frame f (flat ground: v_z + (ω × r)_z)."""
+def normal_velocity(y, f, kind):
+    """g′ = n·(v + ω × r) of the contact with frame f (a rim vertex: v_z + (ω × r)_z)."""
     wx, wy, wz = y[10], y[11], y[12]
-    if flat:
+    if kind == RIM_VERTEX_ON_PLANE:
         return y[9] + (wx * f.ry - wy * f.rx)
     cx = wy * f.rz - wz * f.ry
     cy = wz * f.rx - wx * f.rz
@@ -120,30 +136,31 @@ def bump_normal_acceleration(y, f, acc, bx, by, bz):
 
 
 @hot
-def normal_acceleration(y, f, acc, flat, pts, k):
-    """g″ of contact k (frame f) for accelerations acc."""
-    if flat:
+def normal_acceleration(y, f, acc, kind, pts, k):
+    """g″ of contact k (of kind `kind`, frame f) for accelerations acc."""
+    if kind == RIM_VERTEX_ON_PLANE:
         return vertex_normal_acceleration(y, f, acc)
     return bump_normal_acceleration(y, f, acc, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
 @hot
-def frame_and_rate(y, cols, flat, pts, k):
+def frame_and_rate(y, cols, kind, pts, k):
     """Contact k's frame and normal velocity, without its acceleration (cols: R's
-    first two columns, `rotation.rotation_columns_xy`, used for flat ground)."""
-    if flat:
+    first two columns, `rotation.rotation_columns_xy`, used by a rim vertex)."""
+    if kind == RIM_VERTEX_ON_PLANE:
         f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
     else:
-        f = contact_frame(y, flat, pts, k)
-    return f, normal_velocity(y, f, flat)
+        f = contact_frame(y, kind, pts, k)
+    return f, normal_velocity(y, f, kind)
 
 
 @hot
 def point_jet(y, px, py, acc):
-    """Gap, rate, acceleration and roundoff of the body point (px, py, 0) over flat
-    ground."""
+    """Gap, rate, acceleration and roundoff of the body point (px, py, 0) against the
+    plane z = 0 (a rim vertex)."""
     f = vertex_frame(y, rotation_columns_xy(y), px, py)
-    return Jet(f.gap, normal_velocity(y, f, True), vertex_normal_acceleration(y, f, acc), f.noise)
+    rate = normal_velocity(y, f, RIM_VERTEX_ON_PLANE)
+    return Jet(f.gap, rate, vertex_normal_acceleration(y, f, acc), f.noise)
 
 
 @hot
@@ -159,13 +176,14 @@ def rim_jet(y, acc, radius):
 
 
 @hot
-def contact_jet(y, flat, pts, k, acc):
-    """Gap, rate, acceleration and gap roundoff of contact k for accelerations acc."""
-    if flat:
+def contact_jet(y, kind, pts, k, acc):
+    """Gap, rate, acceleration and gap roundoff of contact k (of kind `kind`) for
+    accelerations acc."""
+    if kind == RIM_VERTEX_ON_PLANE:
         return point_jet(y, pts[k, 0], pts[k, 1], acc)
-    f = contact_frame(y, flat, pts, k)
+    f = contact_frame(y, kind, pts, k)
     return Jet(
-        f.gap, normal_velocity(y, f, flat), normal_acceleration(y, f, acc, flat, pts, k), f.noise
+        f.gap, normal_velocity(y, f, kind), normal_acceleration(y, f, acc, kind, pts, k), f.noise
     )
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import dop853_tableau as tab
 from .clock import grid_time, two_sum_add
-from .contacts import contact_frame
+from .contacts import contact_frame, contact_kind
 from .held import held_forces, held_rhs
 from .jit import copy_into, hot
 from .output import push_sample
@@ -200,7 +200,7 @@ def _lowest_gap(y, model, pts, watch, n_watch):
     """The smallest gap among contacts watch[:n_watch] at y."""
     g = math.inf
     for i in range(n_watch):
-        g = min(g, contact_frame(y, model.flat_ground, pts, watch[i]).gap)
+        g = min(g, contact_frame(y, contact_kind(model, watch[i]), pts, watch[i]).gap)
     return g
 
 

@@ -7,6 +7,7 @@ from .chatter import accumulation_time, completion_speed
 from .contacts import (
     contact_frame,
     contact_jet,
+    contact_kind,
     normal_velocity,
     off_face,
     rate_noise,
@@ -67,7 +68,7 @@ def _completes(state, model, pts, ws, k, m, u, vnoise):
     """Whether contact k, separating at u ≤ the completion speed with cand[:m] held,
     falls back (a_n < 0) or is at rest: then its chatter is completed."""
     acc = held_acceleration(state.y, model, pts, ws.cand, m, ws)
-    a_n = contact_jet(state.y, model.flat_ground, pts, k, acc).accel
+    a_n = contact_jet(state.y, contact_kind(model, k), pts, k, acc).accel
     return a_n < 0 or u <= vnoise, a_n
 
 
@@ -86,7 +87,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
         return False
     k = hitting[0]
     stats.max_penetration = max(
-        stats.max_penetration, -contact_frame(y, model.flat_ground, pts, k).gap
+        stats.max_penetration, -contact_frame(y, contact_kind(model, k), pts, k).gap
     )
     vnoise = rate_noise(y, model.radius)
     copy_into(ws.y_start, y)
@@ -102,9 +103,8 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
     m = 0
     vs = velocity_scale(y, model.radius)
     for i in range(n_rest):
-        vn = normal_velocity(
-            y, contact_frame(y, model.flat_ground, pts, resting[i]), model.flat_ground
-        )
+        kind = contact_kind(model, resting[i])
+        vn = normal_velocity(y, contact_frame(y, kind, pts, resting[i]), kind)
         if vn <= small:
             ws.cand[m] = resting[i]
             m += 1
@@ -192,17 +192,18 @@ def start(state, model, pts, opts, stats, out, ws, cs):
     A body with every contact resting is already at the end of its motion."""
     y = state.y
     state.excess0 = excess_energy(
-        y, model.flat_ground, model.mass, model.i1, model.i3, model.gravity
+        y, model.invariants, model.mass, model.i1, model.i3, model.gravity
     )
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
     vnoise = rate_noise(y, model.radius)
     n_hit = n_rest = 0
     hitting, resting = cs.hitting, cs.together
     for k in range(pts.shape[0]):
-        f = contact_frame(y, model.flat_ground, pts, k)
+        kind = contact_kind(model, k)
+        f = contact_frame(y, kind, pts, k)
         if f.gap > f.noise:
             continue
-        vn = normal_velocity(y, f, model.flat_ground)
+        vn = normal_velocity(y, f, kind)
         if vn < -vnoise:
             hitting[n_hit] = k
             n_hit += 1

@@ -106,8 +106,9 @@ def _height_terms(fx, fy, fz, Lx, Ly, Lz):
 
 @hot
 def vertex_height_bounds(y0, fc, radius, gravity):
-    """Bounds (K, B) ≥ max over the flight and over every vertex of |g″| and |g‴|, flat
-    ground, and the rim's deepest reach below the centre (`rim_depth_bound`).
+    """Bounds (K, B) ≥ max over the flight and over every rim vertex (contact kind
+    RIM_VERTEX_ON_PLANE) of |g″| and |g‴|, and the rim's deepest reach below the centre
+    (`rim_depth_bound`).
 
     A vertex at body angle θ has height z(s) + a (Rot(L̂, Ωs) w(s))_z with
     w = cos φ f1 + sin φ f2, φ = θ + λs, f1, f2 = R0 ê1, R0 ê2.  With (α_i, β_i, γ_i)
@@ -157,15 +158,16 @@ def rim_depth_bound(y0, Lx, Ly, Lz, radius):
 
 
 @hot
-def bump_gap_bounds(y0, fc, pts, gravity, horizon):
-    """Bounds (K, B; depth inf) for the three-point ground over a flight of `horizon`:
+def bump_gap_bounds(y0, fc, pts, first, gravity, horizon):
+    """Bounds (K, B; depth inf) of the floor points pts[first:] (contact kind
+    FLOOR_POINT_ON_FACE) over a flight of `horizon`:
     with g = (x − b)·e3 and e3 precessing at Ω about L,
         g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴,
     |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2."""
     H = horizon if math.isfinite(horizon) else 1e300
     v0 = speed(y0)
     V = v0 + gravity * H
-    D = _farthest_bump(y0, pts) + v0 * H + 0.5 * gravity * H * H
+    D = _farthest_bump(y0, pts, first) + v0 * H + 0.5 * gravity * H * H
     om = fc.omega
     K = gravity + 2 * V * om + D * om * om
     B = 3 * gravity * om + 3 * V * om * om + D * om**3
@@ -173,10 +175,10 @@ def bump_gap_bounds(y0, fc, pts, gravity, horizon):
 
 
 @hot
-def _farthest_bump(y, pts):
-    """The largest distance from the centre of mass to a bump."""
+def _farthest_bump(y, pts, first):
+    """The largest distance from the centre of mass to a floor point pts[first:]."""
     D = 0.0
-    for k in range(pts.shape[0]):
+    for k in range(first, pts.shape[0]):
         d = math.sqrt((y[0] - pts[k, 0]) ** 2 + (y[1] - pts[k, 1]) ** 2 + (y[2] - pts[k, 2]) ** 2)
         D = max(D, d)
     return D
@@ -184,15 +186,15 @@ def _farthest_bump(y, pts):
 
 @hot
 def bound_segment(y, model, pts):
-    """How long a flight from state y is searched with one set of bounds: for ever on
-    flat ground (`vertex_height_bounds` does not depend on it); on the three-point
-    ground max(|v|, √(2 g D))/g, D the farthest bump's distance: over it the speed at
-    most doubles and the distance to a bump at most triples (plus |v|²/2g), so
-    `bump_gap_bounds` stay near their values at its start (without gravity D/|v|: the
-    distance at most doubles)."""
-    if model.flat_ground:
+    """How long a flight from state y is searched with one set of bounds: for ever on a
+    ground of rim vertices alone (`vertex_height_bounds` does not depend on it); with
+    floor points max(|v|, √(2 g D))/g, D the farthest floor point's distance: over it
+    the speed at most doubles and the distance to a floor point at most triples (plus
+    |v|²/2g), so `bump_gap_bounds` stay near their values at its start (without gravity
+    D/|v|: the distance at most doubles)."""
+    if model.n_rim == model.n_contacts:
         return math.inf
-    g, v, D = model.gravity, speed(y), _farthest_bump(y, pts)
+    g, v, D = model.gravity, speed(y), _farthest_bump(y, pts, model.n_rim)
     if g > 0.0:
         return max(v, math.sqrt(2.0 * g * D), TINY) / g
     return D / v if v > 0.0 else math.inf
@@ -200,7 +202,13 @@ def bound_segment(y, model, pts):
 
 @hot
 def flight_bounds(y0, fc, model, pts, horizon):
-    """Bounds for the scene's ground (`vertex_height_bounds` or `bump_gap_bounds`)."""
-    if model.flat_ground:
+    """Bounds for the ground's contacts: `vertex_height_bounds` of its rim vertices,
+    `bump_gap_bounds` of its floor points, the larger K and B of the two when it has
+    both (the rim's depth bound stands: it concerns the rim vertices alone)."""
+    if model.n_rim == model.n_contacts:
         return vertex_height_bounds(y0, fc, model.radius, model.gravity)
-    return bump_gap_bounds(y0, fc, pts, model.gravity, horizon)
+    points = bump_gap_bounds(y0, fc, pts, model.n_rim, model.gravity, horizon)
+    if model.n_rim == 0:
+        return points
+    rim = vertex_height_bounds(y0, fc, model.radius, model.gravity)
+    return Bounds(max(rim.K, points.K), max(rim.B, points.B), rim.depth)

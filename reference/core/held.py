@@ -13,7 +13,7 @@ vertical angular momentum are untouched."""
 
 import numpy as np
 
-from .contacts import contact_frame, normal_acceleration, normal_velocity
+from .contacts import contact_frame, contact_kind, normal_acceleration, normal_velocity
 from .inertia import free_acceleration, impulse_response
 from .jit import hot
 from .linalg import solve_small
@@ -51,14 +51,15 @@ def contact_system(y, model, pts, idx, m, acc, work):
     forces when acc is the free acceleration), work.resp rows = M⁻¹J_iᵀ and w_i, for
     the contacts idx[:m]."""
     for i in range(m):
-        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        kind = contact_kind(model, idx[i])
+        f = contact_frame(y, kind, pts, idx[i])
         rsp = impulse_response(y, f, model.mass, model.i1, model.i3)
         work.resp[i, 0], work.resp[i, 1], work.resp[i, 2] = rsp.dvx, rsp.dvy, rsp.dvz
         work.resp[i, 3], work.resp[i, 4], work.resp[i, 5] = rsp.dwx, rsp.dwy, rsp.dwz
         work.resp[i, 6] = rsp.w
         work.geo[i, 0], work.geo[i, 1], work.geo[i, 2] = f.nx, f.ny, f.nz
         work.geo[i, 3], work.geo[i, 4], work.geo[i, 5] = f.rx, f.ry, f.rz
-        work.b[i] = normal_acceleration(y, f, acc, model.flat_ground, pts, idx[i])
+        work.b[i] = normal_acceleration(y, f, acc, kind, pts, idx[i])
     for i in range(m):
         for j in range(m):
             work.A[i, j] = work.resp[i, 6] if i == j else _row_dot(work.geo, i, work.resp, j)
@@ -119,8 +120,8 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
     acc = free_acceleration(y, model.i1, model.i3, model.gravity)
     contact_system(y, model, pts, idx, m, acc, work)
     for i in range(m):
-        f = contact_frame(y, model.flat_ground, pts, idx[i])
-        work.r[i] = -normal_velocity(y, f, model.flat_ground)
+        kind = contact_kind(model, idx[i])
+        work.r[i] = -normal_velocity(y, contact_frame(y, kind, pts, idx[i]), kind)
     if not solve_small(work.A, work.r, m, work.lam):
         return False
     y[7], y[8], y[9], y[10], y[11], y[12] = add_responses(
@@ -134,7 +135,7 @@ def _gaps_settled(y, model, pts, idx, m, work):
     """work.r = −gaps of contacts idx[:m]; whether each is within its roundoff."""
     settled = True
     for i in range(m):
-        f = contact_frame(y, model.flat_ground, pts, idx[i])
+        f = contact_frame(y, contact_kind(model, idx[i]), pts, idx[i])
         work.r[i] = -f.gap
         if abs(f.gap) > f.noise:
             settled = False

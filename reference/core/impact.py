@@ -9,7 +9,7 @@ undecidable in this model.  Changing the impact law is an edit of
 `post_impact_velocity` alone: the chatter series and the capture of a γ = 0 contact
 (reference.core.chatter, events) use the ratio it gives (`bounce_ratio`)."""
 
-from .contacts import contact_frame, normal_velocity
+from .contacts import contact_frame, contact_kind, normal_velocity
 from .inertia import apply_impulse, impulse_response
 from .jit import hot
 from .records import ImpactOutcome
@@ -33,13 +33,13 @@ def bounce_ratio(gamma):
 @hot
 def impact(y, model, pts, k):
     """In place: the impact of contact k on state y (positions unchanged)."""
-    flat = model.flat_ground
-    f = contact_frame(y, flat, pts, k)
-    u_pre = normal_velocity(y, f, flat)
+    kind = contact_kind(model, k)
+    f = contact_frame(y, kind, pts, k)
+    u_pre = normal_velocity(y, f, kind)
     resp = impulse_response(y, f, model.mass, model.i1, model.i3)
     zeta = (post_impact_velocity(u_pre, model.gamma) - u_pre) / resp.w
     apply_impulse(y, resp, zeta)
-    return ImpactOutcome(zeta, u_pre, normal_velocity(y, f, flat))
+    return ImpactOutcome(zeta, u_pre, normal_velocity(y, f, kind))
 
 
 @hot
@@ -49,8 +49,8 @@ def pushed_contacts(y, model, pts, held, n_held, vnoise, out):
     returns their number (0: the single-impact law stands)."""
     n = 0
     for i in range(n_held):
-        f = contact_frame(y, model.flat_ground, pts, held[i])
-        if normal_velocity(y, f, model.flat_ground) < -vnoise:
+        kind = contact_kind(model, held[i])
+        if normal_velocity(y, contact_frame(y, kind, pts, held[i]), kind) < -vnoise:
             out[n] = held[i]
             n += 1
     return n

@@ -3,7 +3,7 @@ frame): inverse inertia in the world frame, the response of (v, ω) to a normal 
 the torque-free angular acceleration, and energies (paper §2.2–2.3)."""
 
 from .jit import hot
-from .records import Response
+from .records import KEEPS_PLANE_MOMENTA, KEEPS_SPIN, Response
 from .rotation import body_axis
 
 
@@ -95,13 +95,17 @@ def potential_energy(y, mass, gravity):
 
 
 @hot
-def excess_energy(y, flat, mass, i1, i3, gravity):
-    """Energy above the lowest level the invariants allow (the body flat on the ground):
-    flat: E − ½ m |v_h|² − L_z²/(2 I3); three-point: E − ½ I3 ω3²."""
+def excess_energy(y, invariants, mass, i1, i3, gravity):
+    """Energy above the lowest level the ground's invariants allow (the body flat on the
+    ground; `invariants`: records.KEEPS_* bits): the horizontal momentum and L_z kept
+    (vertical contact forces), E − ½ m |v_h|² − L_z²/(2 I3); the spin ω3 kept (forces
+    along e3), E − ½ I3 ω3²; neither, E."""
     e = kinetic_energy(y, mass, i1, i3) + potential_energy(y, mass, gravity)
     e3x, e3y, e3z = body_axis(y)
     w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
-    if flat:
+    if invariants & KEEPS_PLANE_MOMENTA:
         lz = i1 * y[12] + (i3 - i1) * w3 * e3z
-        return e - 0.5 * mass * (y[7] ** 2 + y[8] ** 2) - lz * lz / (2.0 * i3)
-    return e - 0.5 * i3 * w3 * w3
+        e = e - 0.5 * mass * (y[7] ** 2 + y[8] ** 2) - lz * lz / (2.0 * i3)
+    if invariants & KEEPS_SPIN:
+        e = e - 0.5 * i3 * w3 * w3
+    return e

@@ -115,7 +115,7 @@ def _motion_ended(state, model, opts, out):
         return True
     y = state.y
     if state.excess0 > 0:
-        e = excess_energy(y, model.flat_ground, model.mass, model.i1, model.i3, model.gravity)
+        e = excess_energy(y, model.invariants, model.mass, model.i1, model.i3, model.gravity)
         if e <= opts.energy_floor * state.excess0:
             end_run(state, STATUS_ENERGY_EXHAUSTED, none, 0)
             state.t_singularity = extrapolate_singularity(out, state.t_hi)

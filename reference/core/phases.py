@@ -14,6 +14,7 @@ from .candidates import (
 from .clock import grid_time, time_until, two_sum_add
 from .contacts import (
     contact_frame,
+    contact_kind,
     length_rate,
     length_scale,
     rate_noise,
@@ -283,7 +284,7 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
     is looked at (`vertex_window` with K = δ = 0 is exact: the others are above)."""
     n = pts.shape[0]
     first, count = 0, n
-    if use_window(model, opts.window_search, n):
+    if use_window(model, opts.window_search):
         k0, half = vertex_window(y, model.radius, n, 0.0, 0.0, WINDOW_MAX)
         first, count = k0 - half, min(2 * half + 1, n)
     m = 0
@@ -291,7 +292,7 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
         k = (first + i) % n
         if is_held(state, k):
             continue
-        f = contact_frame(y, model.flat_ground, pts, k)
+        f = contact_frame(y, contact_kind(model, k), pts, k)
         if f.gap < -max(f.noise, gap_res):
             cs.together[m] = k
             m += 1

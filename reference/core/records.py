@@ -20,7 +20,7 @@ Response = namedtuple("Response", ["dvx", "dvy", "dvz", "dwx", "dwy", "dwz", "w"
 # to the precessing frame, |ω| and the precession rate Ω = |L|/A.
 FlightConstants = namedtuple("FlightConstants", ["lax", "lay", "laz", "lam", "wabs", "omega"])
 # Bounds on |g″| and |g‴| of every gap over a flight, and on how far below the centre
-# of mass any vertex can be during it (flat ground; inf for the three-point ground).
+# of mass any rim vertex can be during it (inf for a ground without rim vertices).
 Bounds = namedtuple("Bounds", ["K", "B", "depth"])
 # An impact's impulse and the contact's normal velocity before and after it.
 ImpactOutcome = namedtuple("ImpactOutcome", ["impulse", "u_pre", "u_post"])
@@ -33,6 +33,19 @@ EVENT_IMPACT = 1  # a contact reached while approaching
 EVENT_ACTIVATION = 2  # a contact touching at rest with its acceleration into the ground
 EVENT_STUCK = 3  # the search did not converge
 
+# ----------------------------------------------------------------------------- contact kinds
+
+# What a contact is (reference.core.contacts answers for each kind; the Python side
+# describes a ground with them, reference.ground).
+RIM_VERTEX_ON_PLANE = 0  # a body-frame rim vertex against the plane z = 0, normal +z
+FLOOR_POINT_ON_FACE = 1  # a fixed world point touching the body's face, normal e3
+
+# Invariants of the motion that every contact force of a ground keeps (bits): vertical
+# forces keep the horizontal momentum and L_z; forces along e3 through the face keep
+# the spin ω3 of the axisymmetric body (the energy's resting level, inertia.excess_energy).
+KEEPS_PLANE_MOMENTA = 1
+KEEPS_SPIN = 2
+
 # ----------------------------------------------------------------------------- layouts
 
 # The body, its ground and the impact law, as the core reads them.
@@ -44,8 +57,9 @@ MODEL = np.dtype(
         ("radius", np.float64),  # a
         ("gravity", np.float64),  # g (along −z)
         ("gamma", np.float64),  # Newton's restitution coefficient γ
-        ("flat_ground", np.bool_),  # flat ground (contacts = vertices), or three bumps
-        ("n_contacts", np.int64),
+        ("n_contacts", np.int64),  # the ground's contacts: its rim vertices (kind
+        ("n_rim", np.int64),  # RIM_VERTEX_ON_PLANE) 0 … n_rim − 1, then its floor points
+        ("invariants", np.int64),  # KEEPS_* the ground's contact forces all keep
         ("sag", np.float64),  # 1 − cos(π/n): how far a vertex sits above the circle's
         # lowest point, per a sin α, when that point is midway between two vertices
         ("all_down", np.int64),  # contacts held together that end the motion
@@ -111,7 +125,7 @@ STATUS_FAILED_INTEGRATION = 9  # the contact integrator's step fell below roundo
 STATUS_FAILED_NO_ADVANCE = 10  # a contact phase cannot advance before t_end
 STATUS_AT_REST = 11  # singularity at the start: all contacts down and at rest
 STATUS_TILT_FLOOR = 12  # singularity: tilt below TILT_FLOOR after impacts
-STATUS_OFF_FACE = 13  # a contact outside the face's rim (three-point ground): left the bumps
+STATUS_OFF_FACE = 13  # a floor point outside the face's rim (contacts.off_face): left the bumps
 
 # Counters of a run (reference.stats.RunStats reads them by name).
 STATS = np.dtype(

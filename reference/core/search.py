@@ -8,7 +8,9 @@ and pressing into the ground (an activation: it starts to be held).  Contacts wh
 zeros are within their time resolution of the first one's are reached together
 (`collect_together`): the model cannot order them.
 
-Over flat ground, far from it, the circle through the vertices bounds them all at once,
+A ground's rim vertices (contacts 0 … n_rim − 1, kind RIM_VERTEX_ON_PLANE) are searched
+as a family; its other contacts one by one.  Far from the ground, the circle through
+the vertices bounds them all at once,
 for any n (reference.core.rim: a step from the rim's jet, then its lowest point followed
 in closed form down to two sags above the ground).  Nearer, large polygons (n > SMALL_N)
 examine only the vertices that can touch within the step: a vertex's gap, rate and
@@ -21,6 +23,7 @@ import math
 
 from .contacts import (
     contact_jet,
+    contact_kind,
     frame_and_rate,
     normal_acceleration,
     rate_noise,
@@ -30,7 +33,15 @@ from .contacts import (
 )
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
-from .records import EVENT_ACTIVATION, EVENT_IMPACT, EVENT_NONE, EVENT_STUCK, FlightEvent, Jet
+from .records import (
+    EVENT_ACTIVATION,
+    EVENT_IMPACT,
+    EVENT_NONE,
+    EVENT_STUCK,
+    RIM_VERTEX_ON_PLANE,
+    FlightEvent,
+    Jet,
+)
 from .rim import circle_step, far_from_ground, lands_near, rim_descent, rim_step
 from .roots import (
     p2_positive_at,
@@ -65,17 +76,17 @@ def _safe_side_gap(gap, noise):
 
 
 @hot
-def examine(y, acc, cols, flat, pts, k, K, B, vnoise, res):
+def examine(y, acc, cols, kind, pts, k, K, B, vnoise, res):
     """Examine contact k at state y (cols: R's first two columns, formed once for all
     the contacts of a step): update res with its safe step, or record it as hit
     (touching and approaching faster than a graze) or landing (touching at rest,
     accelerating into the ground).  A contact clear of the ground whose P2 is still
     positive at the step found so far does not bind it (`roots.safe_step` would return
     that step): passed over before its acceleration is formed."""
-    f, rate = frame_and_rate(y, cols, flat, pts, k)
+    f, rate = frame_and_rate(y, cols, kind, pts, k)
     if f.gap > f.noise and p2_positive_at(f.gap, rate, K, res[STEP]):
         return
-    j = Jet(f.gap, rate, normal_acceleration(y, f, acc, flat, pts, k), f.noise)
+    j = Jet(f.gap, rate, normal_acceleration(y, f, acc, kind, pts, k), f.noise)
     g = j.gap
     if g <= j.noise:
         graze = GRAZE_FACTOR * math.sqrt(2.0 * max(j.accel, 0.0) * j.noise)
@@ -130,11 +141,11 @@ def examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius):
         return
     cols = rotation_columns_xy(y)
     lead = likely_binding(y, jet, pts, n, K, first, count, radius, res[STEP])
-    examine(y, acc, cols, True, pts, lead, K, B, vnoise, res)
+    examine(y, acc, cols, RIM_VERTEX_ON_PLANE, pts, lead, K, B, vnoise, res)
     k = first % n
     for _ in range(count):
         if k != lead:
-            examine(y, acc, cols, True, pts, k, K, B, vnoise, res)
+            examine(y, acc, cols, RIM_VERTEX_ON_PLANE, pts, k, K, B, vnoise, res)
         k = next_index(k, n)
 
 
@@ -169,12 +180,11 @@ def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise
 
 @hot
 def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
-    """One iteration's certified step (res holds hits and landings): every contact for
-    small n or the three-point ground, else, far from the ground, the circle through the
-    vertices (its step from the rim's jet, then `rim.rim_descent`), or the vertices near
-    the lowest direction.  Returns (step, last certified window step)."""
-    n = pts.shape[0]
-    K, B = bounds.K, bounds.B
+    """One iteration's certified step (res holds hits and landings): the ground's
+    contacts other than rim vertices one by one, and its rim vertices as a family
+    (`_rim_vertices_step`), the shorter step kept (`_shorter_step`).  Returns (step,
+    last certified window step)."""
+    n, n_rim = pts.shape[0], model.n_rim
     res[STEP], res[STEP_K], res[HIT_DS], res[HIT_K], res[LAND_K] = (
         math.inf,
         -1.0,
@@ -182,11 +192,43 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
         -1.0,
         -1.0,
     )
-    if not model.flat_ground:
-        cols = rotation_columns_xy(y)  # (unused by the bumps' frames)
-        for k in range(n):
-            examine(y, acc, cols, False, pts, k, K, B, vnoise, res)
+    if n_rim == n:
+        return _rim_vertices_step(
+            y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res
+        )
+    cols = rotation_columns_xy(y)  # (unused by a floor point's frame)
+    for k in range(n_rim, n):
+        examine(y, acc, cols, contact_kind(model, k), pts, k, bounds.K, bounds.B, vnoise, res)
+    if n_rim == 0:
         return res[STEP], last_dlt
+    return _shorter_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res)
+
+
+@hot
+def _shorter_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
+    """A ground with rim vertices and other contacts (res: the others examined): the
+    shorter of the others' step and the rim vertices' (`_rim_vertices_step`), res[STEP]
+    and res[STEP_K] those of the contact that sets it (the rim's step may exceed its
+    examined vertices' by `rim.rim_step`, which bounds the rim vertices alone)."""
+    other, other_k = res[STEP], res[STEP_K]
+    res[STEP], res[STEP_K] = math.inf, -1.0
+    step, last_dlt = _rim_vertices_step(
+        y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res
+    )
+    if other < step:
+        res[STEP], res[STEP_K] = other, other_k
+        return other, last_dlt
+    return step, last_dlt
+
+
+@hot
+def _rim_vertices_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
+    """The step certified for the rim vertices 0 … n_rim − 1 (into res): far from the
+    ground, the circle through them (its step from the rim's jet, then
+    `rim.rim_descent`), else every vertex for small n, or the vertices near the lowest
+    direction.  Returns (step, last certified window step)."""
+    n = model.n_rim
+    K, B = bounds.K, bounds.B
     jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
     rim = rim_step(y, model.gravity, bounds.depth, model.radius)
     if far_from_ground(y, jet, model):
@@ -218,14 +260,14 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
     t = end
-    flat = model.flat_ground
     cols = rotation_columns_xy(y)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, j = next_index(nxt, n), nxt
         if j == k:
             continue
-        f, rate = frame_and_rate(y, cols, flat, pts, j)
+        kind = contact_kind(model, j)
+        f, rate = frame_and_rate(y, cols, kind, pts, j)
         g = f.gap
         if g <= f.noise:
             if not rate > vnoise:
@@ -233,14 +275,14 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
             g = _safe_side_gap(g, f.noise)
         if p2_positive_at(g, rate, K, t):
             continue  # safe_step would return t: its acceleration is not needed
-        t = min(t, safe_step(g, rate, normal_acceleration(y, f, acc, flat, pts, j), K, B, t))
+        t = min(t, safe_step(g, rate, normal_acceleration(y, f, acc, kind, pts, j), K, B, t))
         if not t > floor:
             return t
     return t
 
 
 @hot
-def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, x, y):
+def _newton_in_bracket(y0, fc, gravity, kind, pts, k, lo, hi, x, y):
     """Contact k's single zero in [lo, hi] (gap > 0 at lo, ≤ 0 at hi, decreasing):
     Newton steps from x in the bracket kept strictly inside the shrinking bracket
     (bisection otherwise), until
@@ -251,7 +293,7 @@ def _newton_in_bracket(y0, fc, gravity, flat, pts, k, lo, hi, x, y):
     6 ulps apart, the cap), so a step onto a bracket end bisects instead."""
     for _ in range(BRACKET_ITERATIONS):
         free_flight(y0, fc, gravity, x, y)
-        j = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, gravity))
+        j = contact_jet(y, kind, pts, k, flight_acceleration(fc, y, gravity))
         if j.gap > 0.0:
             lo = x
         else:
@@ -276,8 +318,8 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     returns its time with y there (the impact test of `examine` holds there), or −1
     when the shortcut does not apply (y then undefined)."""
     k = int(res[STEP_K])
-    flat = model.flat_ground
-    j = contact_jet(y, flat, pts, k, acc)
+    kind = contact_kind(model, k)
+    j = contact_jet(y, kind, pts, k, acc)
     if j.gap <= j.noise:
         return -1.0
     K, B = bounds.K, bounds.B
@@ -295,10 +337,10 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     x0 = min(max(taylor, step), end)
     if (x0 - step) * abs(j.rate) <= j.noise:
         x0 = step
-    x = _newton_in_bracket(y0, fc, model.gravity, flat, pts, k, s + step, s + end, s + x0, y)
+    x = _newton_in_bracket(y0, fc, model.gravity, kind, pts, k, s + step, s + end, s + x0, y)
     if safe < end and x - s > safe:
         return -1.0
-    jr = contact_jet(y, flat, pts, k, flight_acceleration(fc, y, model.gravity))
+    jr = contact_jet(y, kind, pts, k, flight_acceleration(fc, y, model.gravity))
     graze = GRAZE_FACTOR * math.sqrt(2.0 * max(jr.accel, 0.0) * jr.noise)
     if jr.gap <= jr.noise and jr.rate < -max(vnoise, graze):
         return x
@@ -306,13 +348,13 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
 
 
 @hot
-def polish_impact(y0, fc, gravity, flat, pts, k, s_hit, y):
+def polish_impact(y0, fc, gravity, kind, pts, k, s_hit, y):
     """Newton steps on contact k's gap from s_hit; y ends at the polished time, which is
     returned."""
     free_flight(y0, fc, gravity, s_hit, y)
     for _ in range(POLISH_ITERATIONS):
         acc = flight_acceleration(fc, y, gravity)
-        j = contact_jet(y, flat, pts, k, acc)
+        j = contact_jet(y, kind, pts, k, acc)
         corr = -j.gap / j.rate
         if not math.isfinite(corr) or abs(corr) <= POLISH_REL_TOL * max(abs(s_hit), TINY):
             break
@@ -335,9 +377,8 @@ def _candidates(y, model, pts, bounds, windowed):
 def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
     """Contacts reached with k0 at state y (k0 first): approaching, with a zero within
     SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
-    flat = model.flat_ground
     cols = rotation_columns_xy(y)
-    f0, rate0 = frame_and_rate(y, cols, flat, pts, k0)
+    f0, rate0 = frame_and_rate(y, cols, contact_kind(model, k0), pts, k0)
     tres0 = time_resolution(f0.noise, rate0)
     together[0] = k0
     count = 1
@@ -348,7 +389,7 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
         nxt, k = next_index(nxt, n), nxt
         if k == k0:
             continue
-        f, rate = frame_and_rate(y, cols, flat, pts, k)
+        f, rate = frame_and_rate(y, cols, contact_kind(model, k), pts, k)
         if rate >= -vnoise:
             continue
         if reached_together(f.gap, rate, f.noise, tres0):
@@ -366,7 +407,7 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
-        j = contact_jet(y, model.flat_ground, pts, k, acc)
+        j = contact_jet(y, contact_kind(model, k), pts, k, acc)
         if j.gap <= j.noise and j.rate <= vnoise and j.accel < 0:
             together[count] = k
             count += 1
@@ -377,7 +418,7 @@ def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
 def flight_event(y0, fc, model, pts, window_search, horizon, max_iter, y, together, res):
     """The first event of the free flight from y0 within `horizon`, searched segment by
     segment: each with the bounds (`flight.flight_bounds`) of its own length from the
-    state at its start (`flight.bound_segment`: the whole horizon on flat ground, whose
+    state at its start (`flight.bound_segment`: the whole horizon on a ground of rim vertices, whose
     bounds hold for ever; on the three-point ground bounds over the whole horizon would
     grow with its square and cube).  FlightEvent as `find_flight_event`, its iterations
     summed over the segments."""
@@ -404,9 +445,8 @@ def find_flight_event(
     there; y holds the state at s_start on entry): FlightEvent with y at its time (at
     the horizon when there is none) and the contacts reached in together[:n_together]
     (res: 5 floats of scratch)."""
-    n = pts.shape[0]
     g = model.gravity
-    windowed = use_window(model, window_search, n)
+    windowed = use_window(model, window_search)
     s = s_start
     vnoise = rate_noise(y0, model.radius)  # of the flight's state: |ω| is constant
     last_dlt = math.inf
@@ -417,7 +457,8 @@ def find_flight_event(
         )
         if res[HIT_K] >= 0:
             k = int(res[HIT_K])
-            s = polish_impact(y0, fc, g, model.flat_ground, pts, k, s + res[HIT_DS], y)
+            kind = contact_kind(model, k)
+            s = polish_impact(y0, fc, g, kind, pts, k, s + res[HIT_DS], y)
             m = collect_together(y, model, pts, bounds, windowed, k, vnoise, together)
             return FlightEvent(EVENT_IMPACT, s, k, m, it)
         if res[LAND_K] >= 0:

@@ -1,4 +1,5 @@
-"""Vertex windows of large polygons over flat ground.
+"""Vertex windows of large polygons: the rim vertices (contact kind
+RIM_VERTEX_ON_PLANE) near the ground.
 
 A vertex's gap, rate and acceleration are linear in its body direction c = (cos θ,
 sin θ): g = z + a c·u with u = (R20, R21).  So its quadratic lower bound over a step δ,
@@ -18,10 +19,11 @@ _SQRT3 = math.sqrt(3.0)
 
 
 @hot
-def use_window(model, window_search, n):
-    """Whether only the vertices near the lowest direction are examined: large polygons
-    (n > SMALL_N) over flat ground, unless the window search is turned off."""
-    return model.flat_ground and window_search and n > SMALL_N
+def use_window(model, window_search):
+    """Whether only the rim vertices near the lowest direction are examined: a ground
+    of more than SMALL_N rim vertices (model.n_rim) and no other contacts (the windows
+    index the rim vertices alone), unless the window search is turned off."""
+    return window_search and model.n_rim > SMALL_N and model.n_rim == model.n_contacts
 
 
 @hot

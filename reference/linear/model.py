@@ -141,10 +141,12 @@ class LinearModel:
         is ρ a / b (docs/glossary.md, ρ)."""
         body = scene.body
         i1 = body.inertia_diag[0]
-        if scene.ground.kind == "three_point":
-            pts, sym = polygon_points(3, scene.ground.bump_radius), 3
-        else:
+        contacts = scene.contacts
+        if contacts.has_plane:
             pts, sym = polygon_points(body.n, body.radius), body.n
+        else:
+            floor = contacts.floor_points
+            pts, sym = polygon_points(len(floor), contacts.lever(0)), len(floor)
         return cls(
             points=pts,
             mass=float(body.mass),

@@ -1,0 +1,115 @@
+"""A ground as a list of contacts of kinds: the description the reference core, the
+geometry, the metrics, the recordings and the engine adapters build their models from.
+
+The kinds (reference.core.records; their geometry is reference.core.contacts):
+
+- RIM_VERTEX_ON_PLANE: a body-frame rim vertex a(cos 2πk/n, sin 2πk/n, 0) against the
+  plane z = 0, normal +z (engines: a sphere on the body above a plane);
+- FLOOR_POINT_ON_FACE: a fixed world point touching the body's face, normal e3 (engines:
+  a sphere on the ground below a thin box on the body).
+
+A ground lists its rim vertices first (contacts 0 … n_rim − 1), then its floor points;
+`reference.scene.Ground.contacts` builds the list from a scene's [ground] table, and is
+the one place that reads `ground.kind`.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from .core.records import (
+    FLOOR_POINT_ON_FACE,
+    KEEPS_PLANE_MOMENTA,
+    KEEPS_SPIN,
+    RIM_VERTEX_ON_PLANE,
+)
+
+# What each kind is called in text (a contact's label: 'v2', 'b1'), and the invariants
+# of the motion its contact force keeps (records.KEEPS_*: vertical forces keep the
+# horizontal momentum and L_z, forces along e3 the spin ω3).
+KIND_LABEL = {RIM_VERTEX_ON_PLANE: "v", FLOOR_POINT_ON_FACE: "b"}
+KIND_KEEPS = {RIM_VERTEX_ON_PLANE: KEEPS_PLANE_MOMENTA, FLOOR_POINT_ON_FACE: KEEPS_SPIN}
+
+
+@dataclass(frozen=True, eq=False)
+class GroundContacts:
+    """The contacts of a ground: `points` (n, 3), read-only, rows 0 … n_rim − 1 the rim
+    vertices' body-frame points, the rest the floor points' world points."""
+
+    points: np.ndarray
+    n_rim: int
+
+    @property
+    def n(self) -> int:
+        return len(self.points)
+
+    @property
+    def rim_points(self) -> np.ndarray:
+        """(n_rim, 3) body-frame rim vertices (kind RIM_VERTEX_ON_PLANE)."""
+        return self.points[: self.n_rim]
+
+    @property
+    def floor_points(self) -> np.ndarray:
+        """(m, 3) world floor points (kind FLOOR_POINT_ON_FACE)."""
+        return self.points[self.n_rim :]
+
+    @property
+    def has_plane(self) -> bool:
+        """Whether the ground has the plane z = 0 (its rim vertices touch it)."""
+        return self.n_rim > 0
+
+    @property
+    def rim_only(self) -> bool:
+        """Whether every contact is a rim vertex on the plane (then the circle through
+        the vertices bounds every gap from below: z − a sin α)."""
+        return self.n_rim == self.n
+
+    def kind(self, k: int) -> int:
+        """The kind of contact k (`reference.core.contacts.contact_kind`)."""
+        return RIM_VERTEX_ON_PLANE if k < self.n_rim else FLOOR_POINT_ON_FACE
+
+    def label(self, k: int) -> str:
+        """'v2' (rim vertex 2) or 'b1' (floor point 1: numbered among the floor points)."""
+        kind = self.kind(k)
+        return f"{KIND_LABEL[kind]}{k if kind == RIM_VERTEX_ON_PLANE else k - self.n_rim}"
+
+    def lever(self, k: int) -> float:
+        """Contact k's distance from the symmetry axis when the body lies flat on the
+        ground, centred: a for a rim vertex, the floor point's radius b."""
+        return float(np.hypot(self.points[k, 0], self.points[k, 1]))
+
+    @property
+    def invariants(self) -> int:
+        """The records.KEEPS_* bits every contact force keeps (inertia.excess_energy)."""
+        keeps = KEEPS_PLANE_MOMENTA | KEEPS_SPIN
+        if self.n_rim:
+            keeps &= KIND_KEEPS[RIM_VERTEX_ON_PLANE]
+        if self.n > self.n_rim:
+            keeps &= KIND_KEEPS[FLOOR_POINT_ON_FACE]
+        return keeps
+
+    @property
+    def all_down(self) -> int:
+        """How many contacts held together end the motion: all of them, at most three
+        (the rod lies on its two vertices; three contacts fix the body)."""
+        return min(self.n, 3)
+
+
+@functools.lru_cache(maxsize=64)
+def ground_contacts(n_rim: int, radius: float, n_floor: int, floor_radius: float):
+    """GroundContacts of n_rim rim vertices a(cos 2πk/n_rim, sin 2πk/n_rim, 0) then
+    n_floor floor points b(cos 2πk/n_floor, sin 2πk/n_floor, 0) (shared between calls
+    with the same geometry)."""
+    parts = [_regular_points(n_rim, radius), _regular_points(n_floor, floor_radius)]
+    pts = np.concatenate(parts) if n_rim and n_floor else parts[0] if n_rim else parts[1]
+    pts.setflags(write=False)
+    return GroundContacts(pts, n_rim)
+
+
+def _regular_points(k: int, r: float) -> np.ndarray:
+    """(k, 3): r (cos 2πi/k, sin 2πi/k, 0)."""
+    ang = 2.0 * np.pi * np.arange(k) / k
+    return r * np.stack([np.cos(ang), np.sin(ang), np.zeros(k)], axis=1)
