@@ -33,14 +33,8 @@ import math
 
 import numpy as np
 
-from reference.bumpy import bumpy_contact_kinematics, is_bumpy
-from reference.geometry import (
-    contact_points,
-    energies,
-    excess_energy,
-    initial_state,
-    scene_contact_kinematics,
-)
+from reference.geometry import contact_points, energies, excess_energy, initial_state
+from reference.geometry import scene_contact_kinematics as contact_kinematics
 from reference.scene import Scene
 from reference.trajectory import ImpactEvent, Status, Trajectory
 
@@ -61,15 +55,6 @@ def scene_points(scene: Scene) -> np.ndarray:
     """(k, 3) contact points of the scene (`GroundContacts.points`): body-frame rim
     vertices, then world floor points, in the scene's contact numbering."""
     return contact_points(scene.body, scene.ground)
-
-
-def contact_kinematics(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gap and normal velocity (N, k) of every contact of the scene for states (N, 13),
-    in the scene's contact numbering (on bumpy ground: the rim vertices, then the
-    bumps)."""
-    if is_bumpy(scene):
-        return bumpy_contact_kinematics(scene, states)
-    return scene_contact_kinematics(scene, states)
 
 
 def effective_contact_mass(scene: Scene) -> float:

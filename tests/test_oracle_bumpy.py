@@ -13,7 +13,6 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from reference.bumpy import BumpyGround
 from reference.scene import Ground
 from tests.conftest import make_scene
 from tests.oracle import quaternion as qt
@@ -28,7 +27,7 @@ DELTA = 2e-3
 
 
 def bumpy(scene, **ground):
-    return replace(scene, ground=BumpyGround(**ground))
+    return replace(scene, ground=Ground(kind="bumpy", **ground))
 
 
 def tumbling_state() -> np.ndarray:
@@ -162,7 +161,7 @@ def test_bumps_that_never_reach_the_face_give_exactly_the_flat_run():
     (its centre is higher than a·sin α·0.05), so every impact is a rim impact, the same
     as on the flat ground, to the last bit."""
     scene = rolling_scene(gamma=0.5, tilt=0.1, t_end=1.0)
-    far = replace(scene, ground=BumpyGround(bumps=((0.01, 0.0, 0.0), (-0.01, 0.01, 0.0))))
+    far = replace(scene, ground=Ground(kind="bumpy", bumps=((0.01, 0.0, 0.0), (-0.01, 0.01, 0.0))))
     flat = replace(scene, ground=Ground(kind="flat"))
     a, b = oracle_simulate(far), oracle_simulate(flat)
     assert len(b.impacts) > 5

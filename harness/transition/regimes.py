@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from reference.bumpy import BUMP, RIM, bumpy_excess_energy, contact_kinds
+from reference.bumpy import BUMP, RIM, bumpy_excess_energy, contact_kind_names
 from reference.exponent import fit_energy_exponent, pre_impact_samples, states_of, time_to_go
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
@@ -127,7 +127,7 @@ class RunSeries:
 
 
 def run_series(traj: Trajectory, scene: Scene) -> RunSeries:
-    kinds = np.array(contact_kinds(scene))
+    kinds = np.array(contact_kind_names(scene))
     S = states_of(traj)
     energy = bumpy_excess_energy(scene, S) if len(S) else np.zeros(0)
     t_f, source = end_time(traj)
@@ -186,7 +186,7 @@ def regime_summary(series: RunSeries, name: str, t0: float, t1: float) -> dict[s
 def classify(traj: Trajectory, scene: Scene) -> tuple[RunSeries, Activity, list[dict[str, Any]]]:
     """The run's series, its contact activity and its regimes' summaries."""
     series = run_series(traj, scene)
-    act = activity(traj, contact_kinds(scene))
+    act = activity(traj, contact_kind_names(scene))
     t_start = float(traj.t[0]) if traj.n_samples else 0.0
     spans = regime_spans(act, t_start, series.t_f)
     out = [regime_summary(series, name, t0, t1) for name, t0, t1 in spans]
@@ -200,23 +200,20 @@ def takeover(series: RunSeries, act: Activity, scene: Scene) -> dict[str, Any]:
     the face lies a sin α − ρ sin α above the floor at distance ρ from the centre towards
     the lowest point)."""
     a = scene.body.radius
-    heights = [h for _, _, h in scene.ground.bump_table()]
-    radii = [math.hypot(x, y) for x, y, _ in scene.ground.bump_table()]
-    delta_a = max(heights)
-    reach = max(
-        h / (1.0 - r) for (_, _, h), r in zip(scene.ground.bump_table(), radii, strict=True)
-    )
+    bumps = np.asarray(scene.contacts.floor_points)
+    delta = float(bumps[:, 2].max()) if len(bumps) else 0.0
+    reach = max((h / (a - math.hypot(x, y)) for x, y, h in bumps.tolist()), default=math.inf)
     first, last = act.first_bump, act.last_rim
     first_tilt = series.at(series.tilt, first) if first is not None else None
     last_tilt = series.at(series.tilt, last) if last is not None else None
 
     def ratio(x):
-        return None if x is None or delta_a == 0 else x / delta_a
+        return None if x is None or delta == 0 else x / (delta / a)
 
     return {
-        "delta": delta_a * a,
-        "delta_over_a": delta_a,
-        "delta_over_d": 0.5 * delta_a,
+        "delta": delta,
+        "delta_over_a": delta / a,
+        "delta_over_d": 0.5 * delta / a,
         "face_reach_tilt": reach,
         "first_bump_t": first,
         "first_bump_tilt": first_tilt,

@@ -1,7 +1,7 @@
 """The transition study's scene, in the paper's units (Baranyai & Várkonyi, conclusion):
 a disk of diameter d = 0.1 m under g = 9.81 m/s², a floor uneven by Δ = 1e-4 … 1e-5 m,
 modelled as a large regular n-gon (ρ = 0.5) rolling on its rim over the bumpy ground
-(reference.bumpy: three bumps of height Δ at half the radius).
+(reference.bumpy: three bumps of height Δ at half the radius, b = a/2).
 
 The rolling start is the built-in `polygon25-rolling` state scaled by the paper's
 invariance (section 2.6): tilt α about the y axis, the lowest vertex on the floor
@@ -15,8 +15,7 @@ from __future__ import annotations
 
 import math
 
-from reference.bumpy import BumpyGround
-from reference.scene import Body, InitialState, RunSettings, Scene, initial_from_linear
+from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
 
 PAPER_DIAMETER = 0.1  # d [m]
 PAPER_GRAVITY = 9.81  # g [m/s²]
@@ -51,7 +50,7 @@ def transition_scene(
     return Scene(
         name=name,
         body=Body(n=n, radius=a, mass=PAPER_MASS, gyration=gyration),
-        ground=BumpyGround(bump_radius=BUMP_RADIUS, bump_height=delta / a),
+        ground=Ground(kind="bumpy", bump_radius=BUMP_RADIUS * a, bump_height=delta),
         initial=rolling_start(tilt, a, gravity),
         restitution=restitution,
         gravity=gravity,

@@ -12,7 +12,7 @@ Contacts (docs/architecture.md, "The model"):
 
 - `bumpy` (issue 32): both at once, the n vertices on the plane z = 0 first (contacts
   0 … n−1, as on `flat`), then the bumps under the face (contacts n …, as on
-  `three_point`), bump j at a (x_j, y_j, h_j) above the plane.
+  `three_point`), bump j at (x_j, y_j, h_j) above the plane.
 
 For all, d(gap)/dt = n·(v + ω × r) and the normal acceleration is J_k [v̇; ω̇] + bias_k
 with J_k = [nᵀ, (r_k × n)ᵀ].
@@ -44,14 +44,14 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def bumpy_points(scene: Scene) -> np.ndarray:
-    """(m, 3) world bump positions of a bumpy ground, from the scene's numbers (units of
-    the radius): `bumps` when given, else three at bump_radius and bump_height."""
-    g, a = scene.ground, scene.body.radius
+    """(m, 3) world bump positions of a bumpy ground, from the scene's numbers (lengths):
+    `bumps` (x, y, height) when given, else three at bump_radius and bump_height."""
+    g = scene.ground
     if g.bumps is not None:
-        return a * np.array(g.bumps, dtype=float).reshape(-1, 3)
+        return np.array(g.bumps, dtype=float).reshape(-1, 3)
     ang = 2.0 * np.pi * np.arange(3) / 3
     b = g.bump_radius
-    return a * np.stack([b * np.cos(ang), b * np.sin(ang), np.full(3, g.bump_height)], axis=1)
+    return np.stack([b * np.cos(ang), b * np.sin(ang), np.full(3, g.bump_height)], axis=1)
 
 
 @dataclass(frozen=True)
