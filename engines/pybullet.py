@@ -284,7 +284,9 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
             _write_urdf(scene, tmp),
             basePosition=[float(v) for v in x0],
             baseOrientation=[float(q0[1]), float(q0[2]), float(q0[3]), float(q0[0])],
-            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            # implicit cylinder: a true btCylinderShape for the bumpy ground's face (by default
+            # the importer makes a convex hull whose margin puts its bottom 1e-3 low)
+            flags=pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_IMPLICIT_CYLINDER,
             useMaximalCoordinates=maximal,
             **cid,
         )
