@@ -102,3 +102,8 @@ def test_transition_refuses_a_scene_without_bumps(capsys):
 def test_transition_refuses_a_scene_together_with_the_study_options(capsys):
     assert main(["transition", "pentagon-bounce", "--delta", "1e-5"]) == 2
     assert "not both" in capsys.readouterr().err
+
+
+def test_the_linear_model_refuses_the_bumpy_ground(capsys):
+    assert main(["simulate", "bumpy-rolling", "--engine", "linear"]) == 2
+    assert "not bumpy ground" in capsys.readouterr().err

@@ -134,7 +134,7 @@ def _write(
             for run in runs:
                 log_scene(rec, run, scene, schedule, tol)
                 log_rows(rec, run)
-            log_raster(rec, runs, n_contacts, t_max)
+            log_raster(rec, runs, scene.contacts, t_max)
             log_energy_plot(rec, runs, e_plot)
             log_alpha_plot(rec, runs, a_plot)
             text = summary_markdown(runs, scene, t_max)

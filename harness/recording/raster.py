@@ -1,9 +1,12 @@
 """The impact raster: every impact of every simulator as a marker at its time, one lane
 per simulator (the reference on top), the contact index within the lane, the marker's
 size growing with the impulse, and the first impact that disagrees with the reference
-marked by a red cross in that simulator's lane.
+marked by a red cross in that simulator's lane.  On a ground with both contact kinds
+(`bumpy`: the rim vertices, then the bumps above them in the lane) the bump impacts are
+diamonds in their own series, so the kind that took each impulse shows at a glance.
 
     /impacts/<sim>                  SeriesPoints, y = lane base + contact index
+    /impacts/<sim>/bump             the bump impacts (diamonds), on a bumpy ground
     /impacts/lanes/<sim>            a faint guide line under the lane
     /impacts/<sim>/first_mismatch   one red cross at the first mismatch (if any)
     /<sim>/impacts/log              one TextLog line per impact (contact, time, impulse,
@@ -19,6 +22,8 @@ import math
 
 import numpy as np
 import rerun as rr
+
+from reference.contact_kinds import GroundContacts
 
 from .rows import time_column
 from .runs import RunView, mismatch_marker
@@ -52,9 +57,13 @@ def largest_impulse(runs: list[RunView]) -> float:
     )
 
 
-def log_raster(rec: rr.RecordingStream, runs: list[RunView], n_contacts: int, t_max: float) -> None:
+def log_raster(
+    rec: rr.RecordingStream, runs: list[RunView], contacts: GroundContacts, t_max: float
+) -> None:
     """Every lane, its guide line and the mismatch markers (module docstring)."""
     biggest = largest_impulse(runs)
+    n_contacts = contacts.n
+    both = 0 < contacts.n_rim < contacts.n  # rim vertices and bumps: draw the kinds apart
     for k, run in enumerate(runs):
         base = lane_base(k, len(runs), n_contacts)
         _log_lane_guide(rec, run, base, t_max)
@@ -68,22 +77,36 @@ def log_raster(rec: rr.RecordingStream, runs: list[RunView], n_contacts: int, t_
             ),
             static=True,
         )
+        if both:
+            rec.log(
+                f"{path}/bump",
+                rr.SeriesPoints(
+                    colors=[run.color],
+                    names=[f"{run.label} bump impacts"],
+                    markers=["diamond"],
+                ),
+                static=True,
+            )
         imps = run.trajectory.impacts
         if imps:
             traj = run.trajectory
+            contact = traj.impact_contacts()
+            on_bump = contact >= contacts.n_rim if both else np.zeros(len(contact), dtype=bool)
             t = traj.impact_times()
-            y = base + traj.impact_contacts().astype(float)
+            y = base + contact.astype(float)
             sizes = marker_sizes(traj.impact_column("impulse"), biggest)
-            rec.send_columns(
-                path,
-                [time_column(t)],
-                [
-                    *rr.Scalars.columns(scalars=y),
-                    *rr.SeriesPoints.columns(marker_sizes=sizes),
-                ],
-            )
+            for sel, where in ((~on_bump, path), (on_bump, f"{path}/bump")):
+                if sel.any():
+                    rec.send_columns(
+                        where,
+                        [time_column(t[sel])],
+                        [
+                            *rr.Scalars.columns(scalars=y[sel]),
+                            *rr.SeriesPoints.columns(marker_sizes=sizes[sel]),
+                        ],
+                    )
         _log_mismatch(rec, run, base)
-        _log_impact_text(rec, run)
+        _log_impact_text(rec, run, contacts)
 
 
 def _log_lane_guide(rec: rr.RecordingStream, run: RunView, base: float, t_max: float) -> None:
@@ -114,13 +137,15 @@ def _log_mismatch(rec: rr.RecordingStream, run: RunView, base: float) -> None:
     rec.send_columns(path, [time_column([t])], rr.Scalars.columns(scalars=[base + float(contact)]))
 
 
-def _log_impact_text(rec: rr.RecordingStream, run: RunView) -> None:
-    """One line per impact in the run's impact log."""
+def _log_impact_text(rec: rr.RecordingStream, run: RunView, contacts: GroundContacts) -> None:
+    """One line per impact in the run's impact log, naming the contact and its kind
+    ('v2' rim vertex 2, 'b1' bump 1)."""
     imps = run.trajectory.impacts
     if not imps:
         return
     lines = [
-        f"{run.label} impact {i}: contact {e.contact} at t = {float(e.t)!r}"
+        f"{run.label} impact {i}: contact {e.contact} ({contacts.label(e.contact)}) "
+        f"at t = {float(e.t)!r}"
         + (f" (lo {float(e.t_lo):+.3g})" if e.t_lo else "")
         + f", impulse {e.impulse:.6g}, v_n {e.v_normal_pre:.6g} → {e.v_normal_post:.6g}"
         for i, e in enumerate(imps)
