@@ -18,6 +18,8 @@ from reference.trajectory import Trajectory
 # PyBullet 136 s for two (measured); at 1e4 both run (0.8 s and 3.2 s for 100 steps).
 # Linear model: O(n^2) memory, 0.93 GB at n = 1e4.
 MAX_VERTICES = 10_000
+# The linear model's grounds (reference.linear.model.NO_MIXED_GROUND: not bumpy).
+LINEAR_GROUNDS = ("flat", "three_point")
 
 
 def engine_entry(
@@ -25,12 +27,14 @@ def engine_entry(
     library: str | None = None,
     max_vertices: int | None = None,
     reports_progress: bool = False,
+    ground_kinds: tuple[str, ...] | None = None,
 ) -> Callable[[Callable], Callable]:
     """Mark a `simulate(scene, *, dt, t_end)` callable as an engine entry point; `library`
     names the distribution of the physics engine it wraps (shown by `harness engines`);
     `max_vertices` is the largest n it takes (harness.simulators.check_run refuses larger
     ones before the run); `reports_progress`: it accepts `progress=callback(done, total)`
-    and calls it during long runs."""
+    and calls it during long runs; `ground_kinds`: the only grounds it takes (check_run
+    refuses others before the run; None: every ground)."""
 
     def mark(fn: Callable) -> Callable:
         fn.fixed_step = fixed_step
@@ -39,6 +43,8 @@ def engine_entry(
         if max_vertices is not None:
             fn.max_vertices = max_vertices
         fn.reports_progress = reports_progress
+        if ground_kinds is not None:
+            fn.ground_kinds = ground_kinds
         return fn
 
     return mark
@@ -73,7 +79,7 @@ def reference(scene: Scene, *, dt: float | None = None, t_end: float | None = No
     return simulate(scene, t_end=t_end)
 
 
-@engine_entry(fixed_step=False, max_vertices=MAX_VERTICES)
+@engine_entry(fixed_step=False, max_vertices=MAX_VERTICES, ground_kinds=LINEAR_GROUNDS)
 def linear(scene: Scene, *, dt: float | None = None, t_end: float | None = None) -> Trajectory:
     """The paper's linear model, exact event-driven (dt does not apply)."""
     from reference.linear.simulate import simulate_linear

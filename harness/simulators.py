@@ -181,7 +181,8 @@ def check_run(
 ) -> float | None:
     """Everything a run needs, checked before it starts (SceneError, exit status 2):
     t_end in the scene's range (and the scene's speed group with that t_end), the
-    engine's vertex limit (`max_vertices` attribute of its entry point), and for
+    engine's vertex limit and grounds (`max_vertices`, `ground_kinds` attributes of its
+    entry point), and for
     fixed-step engines 0 < dt <= t_end and t_end / dt <= max_steps
     (DEFAULT_MAX_STEPS).  Returns the timestep the engine gets (None: not fixed-step)."""
     simulate = load_engine(engine)
@@ -189,6 +190,11 @@ def check_run(
         raise SceneError(f"--dt must be > 0, got {dt}")
     if t_end is not None:
         scene = scene.with_run(t_end=float(t_end))  # range and speed group, like [run]
+    grounds = getattr(simulate, "ground_kinds", None)
+    if grounds is not None and scene.ground.kind not in grounds:
+        raise SceneError(
+            f"engine {engine!r} takes {' and '.join(grounds)} grounds, not {scene.ground.kind}"
+        )
     limit = getattr(simulate, "max_vertices", None)
     if limit is not None and scene.body.n > limit:
         raise SceneError(

@@ -106,4 +106,4 @@ def test_transition_refuses_a_scene_together_with_the_study_options(capsys):
 
 def test_the_linear_model_refuses_the_bumpy_ground(capsys):
     assert main(["simulate", "bumpy-rolling", "--engine", "linear"]) == 2
-    assert "not bumpy ground" in capsys.readouterr().err
+    assert "not bumpy" in capsys.readouterr().err
