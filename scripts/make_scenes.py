@@ -169,14 +169,14 @@ max_impacts = {s.run.max_impacts}
 
 BUMPY_SCENES = {
     "bumpy-transition": (
-        "100-gon (rho 0.5, gamma 0) rolling at tilt 0.02 over 3 bumps of 1e-4 m, "
+        "100-gon (rho 0.5, gamma 0.5) rolling at tilt 0.02 over 3 bumps of 1e-4 m, "
         "d = 0.1 m, g = 9.81: rim, mixed, bumps to the end",
         dict(delta=1e-4, tilt=0.02, n=100, t_end=1.0, max_impacts=1_000_000),
     ),
     "bumpy-rolling": (
         "20-gon (rho 0.5, gamma 0) rolling at tilt 0.01 over 3 bumps of 1e-4 m, "
         "d = 0.1 m: rim impacts, then the first bump impacts (short: for engines)",
-        dict(delta=1e-4, tilt=0.01, n=20, t_end=0.04, max_impacts=100_000),
+        dict(delta=1e-4, tilt=0.01, n=20, restitution=0.0, t_end=0.04, max_impacts=100_000),
     ),
 }
 

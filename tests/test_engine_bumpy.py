@@ -22,7 +22,7 @@ N = 20
 def short_scene():
     """The 20-gon rolling at tilt 0.01 over bumps of 1e-4 m (Δ/a = 2e-3): rim impacts,
     then the first bump impact near t = 0.028 s."""
-    return transition_scene(delta=1e-4, tilt=0.01, n=N, t_end=0.04)
+    return transition_scene(delta=1e-4, tilt=0.01, n=N, restitution=0.0, t_end=0.04)
 
 
 def _contacts_at(scene, y):

@@ -52,9 +52,9 @@ def test_tilt_is_the_angle_of_the_axis_from_the_vertical():
 
 @pytest.fixture(scope="module")
 def mujoco_run():
-    """MuJoCo (dt = 1e-4) on the 30-gon rolling at tilt 0.01 over bumps of Δ = 1e-4 m
+    """MuJoCo (dt = 1e-4) on the 30-gon (γ = 0) rolling at tilt 0.01 over bumps of Δ = 1e-4 m
     (Δ/a = 2e-3) to rest on the bumps (about 0.1 s)."""
-    scene = transition_scene(delta=1e-4, tilt=0.01, n=30, t_end=0.3)
+    scene = transition_scene(delta=1e-4, tilt=0.01, n=30, restitution=0.0, t_end=0.3)
     return scene, simulate_mujoco(scene, dt=1e-4)
 
 

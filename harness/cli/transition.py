@@ -53,7 +53,9 @@ def register(sub) -> None:
     )
     t.add_argument("--tilt", type=tilt_rad, metavar="RAD", help="start tilt [rad] (default 0.02)")
     t.add_argument("--n", type=vertices, metavar="N", help="vertices of the polygon (default 100)")
-    t.add_argument("--restitution", type=fraction, metavar="GAMMA", help="restitution (default 0)")
+    t.add_argument(
+        "--restitution", type=fraction, metavar="GAMMA", help="restitution (default 0.5)"
+    )
     add_engine(t)
     add_dt(t)
     add_t_end(t)
