@@ -24,9 +24,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 def check_scenes() -> dict:
-    from reference_speed import fast_spin, tumbling
-
+    # the version on PYTHONPATH first: reference_speed puts its own tree on sys.path,
+    # and the modules already imported are the ones it then uses
     from harness.scenes import builtin_names, resolve_scene
+
+    # isort: split
+    from reference_speed import fast_spin, tumbling
 
     out = {f"builtin {name}": resolve_scene(name) for name in builtin_names()}
     out["tumbling n=10 γ=0 flat"] = tumbling(10, 0.0)
@@ -52,8 +55,14 @@ def record(scene) -> dict:
         "t_final": _hex(traj.t_final),
         "t_singularity": _hex(traj.t_singularity),
         "impacts": [
-            [_hex(i.t), _hex(i.t_lo), int(i.contact), _hex(i.impulse), _hex(i.v_normal_pre),
-             _hex(i.v_normal_post)]  # fmt: skip
+            [
+                _hex(i.t),
+                _hex(i.t_lo),
+                int(i.contact),
+                _hex(i.impulse),
+                _hex(i.v_normal_pre),
+                _hex(i.v_normal_post),
+            ]  # fmt: skip
             for i in traj.impacts
         ],
         "phases": [[_hex(p.t_start), _hex(p.t_end), p.kind, list(p.contacts)] for p in traj.phases],

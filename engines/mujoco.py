@@ -40,6 +40,7 @@ import numpy as np
 from mujoco import rollout
 
 from reference import quaternion as qt
+from reference.core import layout as L
 from reference.geometry import free_acceleration, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
@@ -61,9 +62,10 @@ def to_mujoco_state(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reference state [x, q wxyz, v, ω world] (13) → MuJoCo (qpos (7), qvel (6)) with
     qvel's angular part in the body frame: ω_body = R(q)ᵀ ω_world."""
     y = np.asarray(y, dtype=float)
-    q = y[3:7]
+    q = y[L.QUATERNION]
     q_inv = np.array([q[0], -q[1], -q[2], -q[3]])
-    return y[0:7].copy(), np.concatenate([y[7:10], qt.rotate(q_inv, y[10:13])])
+    w_body = qt.rotate(q_inv, y[L.ANGULAR_VELOCITY])
+    return y[L.POSE].copy(), np.concatenate([y[L.VELOCITY], w_body])
 
 
 def from_mujoco_state(qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
@@ -237,7 +239,8 @@ def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
     if half:
         y_after = _states(after[None], nq, nv)[0] if after is not None else None
         states = whole_step_velocities(scene, states, y_after, impulses > 0.0, dt)
-        states[0, 7:13] = y0[7:13]  # known exactly: MuJoCo started from v(−h/2) built from it
+        # known exactly: MuJoCo started from v(−h/2) built from it
+        states[0, L.VELOCITIES] = y0[L.VELOCITIES]
     steps = len(t) - 1
     stats = {
         "wall_time_s": time.perf_counter() - t_wall,
@@ -297,7 +300,7 @@ def staggered_start(scene: Scene, y0: np.ndarray, dt: float) -> np.ndarray:
     under gravity makes every flight's height low by g h t/2 and its impacts early by
     ~g h t/(2|vₙ|) (first order in h)."""
     y = np.array(y0, dtype=float)
-    y[7:13] -= 0.5 * dt * free_acceleration(scene, y0)[0]
+    y[L.VELOCITIES] -= 0.5 * dt * free_acceleration(scene, y0)[0]
     return y
 
 
@@ -318,19 +321,19 @@ def whole_step_velocities(
     v(t_n) = v(t_n + h/2) − (h/2)·a_free (post-impact, as the exact motion is at t_n,
     after the gap's zero crossing)."""
     out = states.copy()
-    nxt = np.empty_like(states[:, 7:13])
-    nxt[:-1] = states[1:, 7:13]
+    nxt = np.empty_like(states[:, L.VELOCITIES])
+    nxt[:-1] = states[1:, L.VELOCITIES]
     if after is not None:
-        nxt[-1] = after[7:13]
+        nxt[-1] = after[L.VELOCITIES]
     else:
-        nxt[-1] = states[-1, 7:13] + dt * free_acceleration(scene, states[-1])[0]
-    out[:, 7:13] = 0.5 * (states[:, 7:13] + nxt)
+        nxt[-1] = states[-1, L.VELOCITIES] + dt * free_acceleration(scene, states[-1])[0]
+    out[:, L.VELOCITIES] = 0.5 * (states[:, L.VELOCITIES] + nxt)
     onset = active.any(axis=1)
     onset[1:] &= (active[1:] & ~active[:-1]).any(axis=1)
     for j in np.flatnonzero(onset):
         y = states[j].copy()
-        y[7:13] = nxt[j]
-        out[j, 7:13] = nxt[j] - 0.5 * dt * free_acceleration(scene, y)[0]
+        y[L.VELOCITIES] = nxt[j]
+        out[j, L.VELOCITIES] = nxt[j] - 0.5 * dt * free_acceleration(scene, y)[0]
     return out
 
 

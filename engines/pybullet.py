@@ -70,6 +70,7 @@ import numpy as np
 from engines.base import build_trajectory
 from engines.quiet import quiet_import
 from reference import quaternion as qt
+from reference.core import layout as L
 from reference.geometry import energies, initial_state
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
@@ -278,7 +279,7 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
     pb.setPhysicsEngineParameter(**_engine_parameters(scene, dt, profile), **cid)
 
     y0 = initial_state(scene.initial)
-    x0, q0 = y0[0:3], y0[3:7]
+    x0, q0 = y0[L.POSITION], y0[L.QUATERNION]
     with tempfile.TemporaryDirectory(prefix="pybullet-scene-") as tmp:
         body = pb.loadURDF(
             _write_urdf(scene, tmp),
@@ -290,7 +291,8 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
             useMaximalCoordinates=maximal,
             **cid,
         )
-    pb.resetBaseVelocity(body, [float(v) for v in y0[7:10]], [float(v) for v in y0[10:13]], **cid)
+    v0, w0 = y0[L.VELOCITY], y0[L.ANGULAR_VELOCITY]
+    pb.resetBaseVelocity(body, [float(v) for v in v0], [float(v) for v in w0], **cid)
 
     ground: tuple[int, ...] = ()  # the plane first (if any), then the bumps in order
     if scene.contacts.has_plane:
@@ -369,7 +371,9 @@ def contact_forces(h: Handles, scene: Scene) -> np.ndarray:
         if cp[9] > 0.0 and cp[8] <= h.processing_threshold:
             g = ground_index[cp[2]]
             if contacts.has_plane and g == 0:
-                k = _contact_index_flat(np.array([cp[5]]), y[0:3], y[3:7], scene.body.n)[0]
+                k = _contact_index_flat(
+                    np.array([cp[5]]), y[L.POSITION], y[L.QUATERNION], scene.body.n
+                )[0]
             else:
                 k = contacts.n_rim + g - int(contacts.has_plane)
             forces[k] += cp[9]
@@ -552,7 +556,7 @@ def _impulses(hits, J, Y, has_plane, n_rim, n_contacts, dt) -> np.ndarray:
     for r in np.unique(prev[on_plane]):
         sel = on_plane & (prev == r)
         y = Y[r]
-        k[sel] = _contact_index_flat(H[sel, 2:5], y[0:3], y[3:7], n_rim)
+        k[sel] = _contact_index_flat(H[sel, 2:5], y[L.POSITION], y[L.QUATERNION], n_rim)
     np.add.at(out, (row, k), H[:, 5] * dt)
     return out
 

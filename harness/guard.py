@@ -26,6 +26,7 @@ import numpy as np
 
 from reference import geometry
 from reference import quaternion as qt
+from reference.core import layout as L
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
@@ -65,7 +66,7 @@ def first_invalid_sample(scene: Scene, traj: Trajectory) -> tuple[int, str] | No
         & np.isfinite(traj.kinetic_energy)
         & np.isfinite(traj.potential_energy)
     )
-    norm = np.linalg.norm(np.where(finite[:, None], states[:, 3:7], 1.0), axis=1)
+    norm = np.linalg.norm(np.where(finite[:, None], states[:, L.QUATERNION], 1.0), axis=1)
     unit = np.abs(norm - 1.0) <= QUATERNION_NORM_TOLERANCE
     checks = [
         (finite, "a non-finite value (NaN or infinity)"),
@@ -137,8 +138,8 @@ def _first_below(
     in a sane run."""
     rows = states[:stop] if stop is not None else states
     if scene.contacts.rim_only:
-        e3 = qt.body_axis(qt.normalize(rows[:, 3:7]))
-        bound = rows[:, 2] - scene.body.radius * np.hypot(e3[:, 0], e3[:, 1])
+        e3 = qt.body_axis(qt.normalize(rows[:, L.QUATERNION]))
+        bound = rows[:, L.Z] - scene.body.radius * np.hypot(e3[:, 0], e3[:, 1])
         candidates = np.flatnonzero(bound < depth)
     else:
         candidates = np.arange(len(rows))

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .compiled import function
+from .core import layout as L
 from .quaternion import from_rotation_vector
 
 if TYPE_CHECKING:  # geometry depends on no other module of the package
@@ -39,16 +40,16 @@ def contact_points(body: Body, ground: Ground) -> np.ndarray:
 
 def initial_state(initial: InitialState) -> np.ndarray:
     """The 13-component state of an InitialState (attitude from its rotation vector)."""
-    y = np.zeros(13)
-    y[0:3] = initial.position
-    y[3:7] = from_rotation_vector(initial.rotation_vector)
-    y[7:10] = initial.velocity
-    y[10:13] = initial.angular_velocity
+    y = np.zeros(L.STATE_SIZE)
+    y[L.POSITION] = initial.position
+    y[L.QUATERNION] = from_rotation_vector(initial.rotation_vector)
+    y[L.VELOCITY] = initial.velocity
+    y[L.ANGULAR_VELOCITY] = initial.angular_velocity
     return y
 
 
 def _states(states: np.ndarray) -> np.ndarray:
-    return np.ascontiguousarray(np.asarray(states, dtype=float).reshape(-1, 13))
+    return np.ascontiguousarray(np.asarray(states, dtype=float).reshape(-1, L.STATE_SIZE))
 
 
 def contact_kinematics(

@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from .contact_kinds import GroundContacts, ground_contacts, listed_contacts
+from .core.layout import QUATERNION
 from .geometry import initial_state, scene_contact_kinematics
 from .quaternion import body_axis
 
@@ -445,7 +446,7 @@ def check_not_below_ground(scene: Scene) -> None:
         raise SceneError(
             f"the body starts below the ground: contact {worst} is at gap {gaps[worst]:.3g}"
         )
-    if len(scene.contacts.floor_points) and body_axis(y0[3:7])[2] <= 0.0:
+    if len(scene.contacts.floor_points) and body_axis(y0[QUATERNION])[2] <= 0.0:
         raise SceneError(f"{scene.ground.kind} ground needs the body's face normal pointing up")
 
 

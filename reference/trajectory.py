@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from . import quaternion as qt
+from .core import layout as L
 
 
 class Status(StrEnum):
@@ -112,10 +113,10 @@ class Trajectory:
             engine=engine,
             scene=scene,
             t=np.asarray(t, dtype=float),
-            position=S[:, 0:3],
-            quaternion=S[:, 3:7],
-            velocity=S[:, 7:10],
-            angular_velocity=S[:, 10:13],
+            position=S[:, L.POSITION],
+            quaternion=S[:, L.QUATERNION],
+            velocity=S[:, L.VELOCITY],
+            angular_velocity=S[:, L.ANGULAR_VELOCITY],
             kinetic_energy=np.asarray(kinetic_energy, dtype=float),
             potential_energy=np.asarray(potential_energy, dtype=float),
             impacts=impacts,

@@ -16,6 +16,7 @@ from collections import namedtuple
 from .contacts import contact_jet, contact_kind, rim_jet, vertex_gap_noise
 from .horizon import horizon_bound, local_time_cap, safe_horizon
 from .jit import hot
+from .layout import Z
 from .roots import quadratic_taylor_root
 from .tolerances import WINDOW_GROW, WINDOW_MAX, WINDOW_ROUNDS
 from .window import use_window, vertex_window, window_offsets
@@ -70,7 +71,7 @@ def touching_candidates(state, model, pts, opts, acc, cs, touch):
         return Examined(m, horizon_bound(acc_scale, model.gravity), 0, 0, n - 1, False)
     _, _, _, _, rx, ry = rim_jet(y, acc, model.radius)
     K = horizon_bound(abs(acc[2]) + math.sqrt(rx * rx + ry * ry), model.gravity)
-    lift = max(touch, vertex_gap_noise(y[2], model.radius))
+    lift = max(touch, vertex_gap_noise(y[Z], model.radius))
     k0, half = vertex_window(y, model.radius, n, K, 0.0, WINDOW_MAX, lift)
     m = _list_free(state, cs, k0 - half, min(2 * half + 1, n), n, 0)
     _jets(y, model, pts, acc, cs, 0, m)

@@ -14,6 +14,7 @@ import math
 from .contacts import contact_frame, contact_kind, velocity_scale
 from .impact import bounce_ratio
 from .jit import hot
+from .layout import WX, WY, WZ
 from .tolerances import CHATTER_BOUNCE_FLOOR, TINY
 
 
@@ -27,7 +28,7 @@ def completion_speed(y, model, pts, k, chatter_tol, vnoise):
         return vnoise
     small = chatter_tol * velocity_scale(y, model.radius)
     noise = contact_frame(y, contact_kind(model, k), pts, k).noise
-    a_scale = model.gravity + model.radius * (y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    a_scale = model.gravity + model.radius * (y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2)
     return max(small, CHATTER_BOUNCE_FLOOR * math.sqrt(2.0 * a_scale * noise), vnoise)
 
 

@@ -23,6 +23,7 @@ Accelerations `acc` are tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
 import math
 
 from .jit import hot
+from .layout import VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE, Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
 from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTOR, TINY
@@ -30,9 +31,15 @@ from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTO
 
 @hot
 def contact_kind(model, k):
-    """The kind of the ground's contact k: its rim vertices come first (model.n_rim of
-    them), its floor points after."""
-    return RIM_VERTEX_ON_PLANE if k < model.n_rim else FLOOR_POINT_ON_FACE
+    """The kind of the ground's contact k (`kind_in_ground` with model.n_rim)."""
+    return kind_in_ground(model.n_rim, k)
+
+
+@hot
+def kind_in_ground(n_rim, k):
+    """The kind of contact k of a ground whose rim vertices come first (n_rim of them)
+    and its floor points after (for loops over contacts, n_rim read once)."""
+    return RIM_VERTEX_ON_PLANE if k < n_rim else FLOOR_POINT_ON_FACE
 
 
 @hot
@@ -56,7 +63,7 @@ def vertex_frame(y, cols, px, py):
     at state y): gap z + r_z, normal e_z, lever r, roundoff GAP_NOISE_ULPS ε (|z| +
     |r_z|)."""
     rx, ry, rz = lever_of_columns(cols, px, py)
-    return Frame(y[2] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[2], rz))
+    return Frame(y[Z] + rz, 0.0, 0.0, 1.0, rx, ry, rz, vertex_gap_noise(y[Z], rz))
 
 
 @hot
@@ -71,7 +78,7 @@ def bump_frame(y, bx, by, bz):
     """Frame of the ground bump b under the body's face: gap d·e3 (d = x − b), normal e3,
     lever −d + gap e3, roundoff GAP_NOISE_ULPS ε Σ|d_j e3_j|."""
     ex, ey, ez = body_axis(y)
-    dx, dy, dz = y[0] - bx, y[1] - by, y[2] - bz
+    dx, dy, dz = y[X] - bx, y[Y] - by, y[Z] - bz
     gap = dx * ex + dy * ey + dz * ez
     noise = GAP_NOISE_ULPS * EPS * (abs(dx * ex) + abs(dy * ey) + abs(dz * ez))
     return Frame(gap, ex, ey, ez, -dx + gap * ex, -dy + gap * ey, -dz + gap * ez, noise)
@@ -100,20 +107,20 @@ def off_face(y, model, pts, k):
 @hot
 def normal_velocity(y, f, kind):
     """g′ = n·(v + ω × r) of the contact with frame f (a rim vertex: v_z + (ω × r)_z)."""
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     if kind == RIM_VERTEX_ON_PLANE:
-        return y[9] + (wx * f.ry - wy * f.rx)
+        return y[VZ] + (wx * f.ry - wy * f.rx)
     cx = wy * f.rz - wz * f.ry
     cy = wz * f.rx - wx * f.rz
     cz = wx * f.ry - wy * f.rx
-    return f.nx * (y[7] + cx) + f.ny * (y[8] + cy) + f.nz * (y[9] + cz)
+    return f.nx * (y[VX] + cx) + f.ny * (y[VY] + cy) + f.nz * (y[VZ] + cz)
 
 
 @hot
 def vertex_normal_acceleration(y, f, acc):
     """g″ = v̇_z + (ω̇ × r)_z + (ω × (ω × r))_z of a vertex over flat ground, with
     (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z."""
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     return (
         acc[2]
         + (acc[3] * f.ry - acc[4] * f.rx)
@@ -125,14 +132,14 @@ def vertex_normal_acceleration(y, f, acc):
 @hot
 def bump_normal_acceleration(y, f, acc, bx, by, bz):
     """g″ = n·v̇ + (r × n)·ω̇ + 2 v·(ω × e3) + d·(ω × (ω × e3)) of a bump, d = x − b."""
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     nx, ny, nz = f.nx, f.ny, f.nz
     cx, cy, cz = f.ry * nz - f.rz * ny, f.rz * nx - f.rx * nz, f.rx * ny - f.ry * nx
     lin = nx * acc[0] + ny * acc[1] + nz * acc[2] + cx * acc[3] + cy * acc[4] + cz * acc[5]
     ux, uy, uz = wy * nz - wz * ny, wz * nx - wx * nz, wx * ny - wy * nx  # ω × e3
     vx, vy, vz = wy * uz - wz * uy, wz * ux - wx * uz, wx * uy - wy * ux  # ω × (ω × e3)
-    dx, dy, dz = y[0] - bx, y[1] - by, y[2] - bz
-    return lin + 2.0 * (y[7] * ux + y[8] * uy + y[9] * uz) + dx * vx + dy * vy + dz * vz
+    dx, dy, dz = y[X] - bx, y[Y] - by, y[Z] - bz
+    return lin + 2.0 * (y[VX] * ux + y[VY] * uy + y[VZ] * uz) + dx * vx + dy * vy + dz * vz
 
 
 @hot
@@ -149,8 +156,8 @@ def frame_and_rate(y, cols, kind, pts, k):
     first two columns, `rotation.rotation_columns_xy`, used by a rim vertex)."""
     if kind == RIM_VERTEX_ON_PLANE:
         f = vertex_frame(y, cols, pts[k, 0], pts[k, 1])
-    else:
-        f = contact_frame(y, kind, pts, k)
+    else:  # FLOOR_POINT_ON_FACE
+        f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
     return f, normal_velocity(y, f, kind)
 
 
@@ -171,7 +178,7 @@ def rim_jet(y, acc, radius):
     |g″| ≤ |v̇_z| + |r| for every point of the rim."""
     jx = point_jet(y, radius, 0.0, acc)
     jy = point_jet(y, 0.0, radius, acc)
-    z, vz = y[2], y[9]
+    z, vz = y[Z], y[VZ]
     return jx.gap - z, jy.gap - z, jx.rate - vz, jy.rate - vz, jx.accel - acc[2], jy.accel - acc[2]
 
 
@@ -181,22 +188,22 @@ def contact_jet(y, kind, pts, k, acc):
     accelerations acc."""
     if kind == RIM_VERTEX_ON_PLANE:
         return point_jet(y, pts[k, 0], pts[k, 1], acc)
-    f = contact_frame(y, kind, pts, k)
-    return Jet(
-        f.gap, normal_velocity(y, f, kind), normal_acceleration(y, f, acc, kind, pts, k), f.noise
-    )
+    bx, by, bz = pts[k, 0], pts[k, 1], pts[k, 2]  # FLOOR_POINT_ON_FACE
+    f = bump_frame(y, bx, by, bz)
+    accel = bump_normal_acceleration(y, f, acc, bx, by, bz)
+    return Jet(f.gap, normal_velocity(y, f, kind), accel, f.noise)
 
 
 @hot
 def speed(y):
     """|v|, the speed of the centre of mass."""
-    return math.sqrt(y[7] ** 2 + y[8] ** 2 + y[9] ** 2)
+    return math.sqrt(y[VX] ** 2 + y[VY] ** 2 + y[VZ] ** 2)
 
 
 @hot
 def velocity_scale(y, radius):
     """V = |v| + a|ω|: the largest speed of a rim point (the local velocity unit)."""
-    return speed(y) + radius * math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    return speed(y) + radius * math.sqrt(y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2)
 
 
 @hot
@@ -209,7 +216,7 @@ def rate_noise(y, radius):
 def length_scale(y, radius):
     """L = |z| + a sin α: the height of the centre plus the rim's vertical extent."""
     ex, ey, _ = body_axis(y)
-    return abs(y[2]) + radius * math.sqrt(ex * ex + ey * ey)
+    return abs(y[Z]) + radius * math.sqrt(ex * ex + ey * ey)
 
 
 @hot
@@ -217,9 +224,9 @@ def length_rate(y, radius):
     """U = |ż| + a|ω × e3| ≥ |L′|: how fast L = |z| + a sin α may change (a spin about
     the body's axis leaves it)."""
     ex, ey, ez = body_axis(y)
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     ux, uy, uz = wy * ez - wz * ey, wz * ex - wx * ez, wx * ey - wy * ex
-    return abs(y[9]) + radius * math.sqrt(ux * ux + uy * uy + uz * uz)
+    return abs(y[VZ]) + radius * math.sqrt(ux * ux + uy * uy + uz * uz)
 
 
 @hot

@@ -20,6 +20,7 @@ from .clock import grid_time, two_sum_add
 from .contacts import contact_frame, contact_kind
 from .held import held_forces, held_rhs
 from .jit import copy_into, hot
+from .layout import STATE_SIZE
 from .output import push_sample
 from .tolerances import EPS, LOCATE_ITERATIONS, LOCATE_XTOL
 
@@ -64,17 +65,17 @@ def dop853_step(y, f0, h, model, pts, idx, m, work, K, y_new, tmp):
 @hot
 def stage_state(y, h, weights, K, s, out):
     """out = y + h Σ_{j<s} weights[j] K[j]: a Runge–Kutta stage's state.  The sum runs
-    over stages j in order, row by row (13 contiguous components at a time, zero
+    over stages j in order, row by row (STATE_SIZE contiguous components at a time, zero
     weights skipped): for each component the same additions in the same order as a
     column-wise sum, so the same bits (measured: one-impact run 11.78 → 11.51 µs)."""
-    for c in range(13):
+    for c in range(STATE_SIZE):
         out[c] = 0.0
     for j in range(s):
         w = weights[j]
         if w != 0.0:
-            for c in range(13):
+            for c in range(STATE_SIZE):
                 out[c] += w * K[j, c]
-    for c in range(13):
+    for c in range(STATE_SIZE):
         out[c] = y[c] + h * out[c]
 
 
@@ -88,10 +89,10 @@ def heun_euler_step(y, f0, h, rtol, atol, model, pts, idx, m, work, st, y_new):
     far below the integrator's (`phases._short_chunk`), where a DOP853 step's 12
     evaluations buy nothing.  Returns the error norm (≤ 1: accepted)."""
     f1 = st.Ks[0]
-    for c in range(13):
+    for c in range(STATE_SIZE):
         st.ys[c] = y[c] + h * f0[c]
     held_rhs(st.ys, model, pts, idx, m, work, f1)
-    for c in range(13):
+    for c in range(STATE_SIZE):
         y_new[c] = y[c] + 0.5 * h * (f0[c] + f1[c])
         st.tmp[c] = 0.5 * h * (f1[c] - f0[c])
     step_scale(y, y_new, rtol, atol, st.scale)
@@ -102,7 +103,7 @@ def heun_euler_step(y, f0, h, rtol, atol, model, pts, idx, m, work, st, y_new):
 def step_scale(y, y_new, rtol, atol, scale):
     """scale = atol + rtol max(|y|, |y_new|): what a step's error is measured against
     (scipy's rk.RungeKutta._step_impl)."""
-    for c in range(13):
+    for c in range(STATE_SIZE):
         scale[c] = atol[c] + max(abs(y[c]), abs(y_new[c])) * rtol
 
 
@@ -119,7 +120,7 @@ def error_norm(K, h, scale):
     """scipy's DOP853 error norm (rk.DOP853._estimate_error_norm)."""
     e5 = 0.0
     e3 = 0.0
-    for c in range(13):
+    for c in range(STATE_SIZE):
         a5 = 0.0
         a3 = 0.0
         for j in range(N_STAGES + 1):
@@ -129,25 +130,25 @@ def error_norm(K, h, scale):
         e3 += (a3 / scale[c]) ** 2
     if e5 == 0.0 and e3 == 0.0:
         return 0.0
-    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * 13)
+    return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * STATE_SIZE)
 
 
 @hot
 def initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st):
     """scipy.integrate._ivp.common.select_initial_step for order 7.  Returns (h, nfev)."""
-    for c in range(13):
+    for c in range(STATE_SIZE):
         st.scale[c] = atol[c] + abs(y[c]) * rtol
     d0 = _rms(y, st.scale)
     d1 = _rms(f, st.scale)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, s_end)
-    for c in range(13):
+    for c in range(STATE_SIZE):
         st.ys[c] = y[c] + h0 * f[c]
     held_rhs(st.ys, model, pts, idx, m, work, st.tmp)
     d2 = 0.0
-    for c in range(13):
+    for c in range(STATE_SIZE):
         d2 += ((st.tmp[c] - f[c]) / st.scale[c]) ** 2
-    d2 = math.sqrt(d2 / 13) / h0
+    d2 = math.sqrt(d2 / STATE_SIZE) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
@@ -167,7 +168,7 @@ def dense_output(y, y_new, h, model, pts, idx, m, work, st):
         row = N_STAGES + 1 + s
         stage_state(y, h, DOP_A_EXTRA[s], K, row, st.tmp)
         held_rhs(st.tmp, model, pts, idx, m, work, K[row])
-    for c in range(13):
+    for c in range(STATE_SIZE):
         dy = y_new[c] - y[c]
         F[0, c] = dy
         F[1, c] = h * K[0, c] - dy
@@ -187,7 +188,7 @@ def dense_state(y, F, x, out):
     """The interpolated state at the fraction x ∈ [0, 1] of the step from y
     (Dop853DenseOutput._call_impl)."""
     n_pow = F.shape[0]
-    for c in range(13):
+    for c in range(STATE_SIZE):
         v = 0.0
         for i in range(n_pow):
             v += F[n_pow - 1 - i, c]

@@ -13,6 +13,7 @@ import math
 
 from .contacts import speed
 from .jit import hot
+from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .records import Bounds, FlightConstants
 from .rotation import body_axis, qmul, rotation_columns_xy, rotation_vector_quaternion
 from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS, TINY
@@ -22,33 +23,33 @@ from .tolerances import BOUND_MARGIN, BOUND_ULPS, EPS, TINY
 def flight_constants(y, i1, i3):
     """L/A, λ, |ω| and Ω of the free flight starting at state y."""
     e3x, e3y, e3z = body_axis(y)
-    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
-    lax = y[10] - w3 * e3x + (i3 / i1) * w3 * e3x
-    lay = y[11] - w3 * e3y + (i3 / i1) * w3 * e3y
-    laz = y[12] - w3 * e3z + (i3 / i1) * w3 * e3z
+    w3 = y[WX] * e3x + y[WY] * e3y + y[WZ] * e3z
+    lax = y[WX] - w3 * e3x + (i3 / i1) * w3 * e3x
+    lay = y[WY] - w3 * e3y + (i3 / i1) * w3 * e3y
+    laz = y[WZ] - w3 * e3z + (i3 / i1) * w3 * e3z
     lam = (1.0 / i3 - 1.0 / i1) * i3 * w3
-    wabs = math.sqrt(y[10] ** 2 + y[11] ** 2 + y[12] ** 2)
+    wabs = math.sqrt(y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2)
     return FlightConstants(lax, lay, laz, lam, wabs, math.sqrt(lax * lax + lay * lay + laz * laz))
 
 
 @hot
 def free_flight(y0, fc, gravity, s, out):
     """The state after a free flight of duration s from y0, into `out` (closed form)."""
-    out[0] = y0[0] + y0[7] * s
-    out[1] = y0[1] + y0[8] * s
-    out[2], out[9] = centre_height(y0[2], y0[9], gravity, s)
-    out[7] = y0[7]
-    out[8] = y0[8]
+    out[X] = y0[X] + y0[VX] * s
+    out[Y] = y0[Y] + y0[VY] * s
+    out[Z], out[VZ] = centre_height(y0[Z], y0[VZ], gravity, s)
+    out[VX] = y0[VX]
+    out[VY] = y0[VY]
     p0, p1, p2, p3 = rotation_vector_quaternion(fc.lax * s, fc.lay * s, fc.laz * s)
-    a = qmul(p0, p1, p2, p3, y0[3], y0[4], y0[5], y0[6])
+    a = qmul(p0, p1, p2, p3, y0[QW], y0[QX], y0[QY], y0[QZ])
     half = 0.5 * fc.lam * s
     b = qmul(a[0], a[1], a[2], a[3], math.cos(half), 0.0, 0.0, math.sin(half))
     nrm = math.sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3])
-    out[3], out[4], out[5], out[6] = b[0] / nrm, b[1] / nrm, b[2] / nrm, b[3] / nrm
+    out[QW], out[QX], out[QY], out[QZ] = b[0] / nrm, b[1] / nrm, b[2] / nrm, b[3] / nrm
     e3x, e3y, e3z = body_axis(out)
-    out[10] = fc.lax + fc.lam * e3x
-    out[11] = fc.lay + fc.lam * e3y
-    out[12] = fc.laz + fc.lam * e3z
+    out[WX] = fc.lax + fc.lam * e3x
+    out[WY] = fc.lay + fc.lam * e3y
+    out[WZ] = fc.laz + fc.lam * e3z
 
 
 @hot
@@ -179,7 +180,7 @@ def _farthest_bump(y, pts, first):
     """The largest distance from the centre of mass to a floor point pts[first:]."""
     D = 0.0
     for k in range(first, pts.shape[0]):
-        d = math.sqrt((y[0] - pts[k, 0]) ** 2 + (y[1] - pts[k, 1]) ** 2 + (y[2] - pts[k, 2]) ** 2)
+        d = math.sqrt((y[X] - pts[k, 0]) ** 2 + (y[Y] - pts[k, 1]) ** 2 + (y[Z] - pts[k, 2]) ** 2)
         D = max(D, d)
     return D
 

@@ -16,6 +16,7 @@ import numpy as np
 from .contacts import contact_frame, contact_kind, normal_acceleration, normal_velocity
 from .inertia import free_acceleration, impulse_response
 from .jit import hot
+from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .linalg import solve_small
 from .records import SCRATCH
 from .rotation import quaternion_rate, rotate_attitude
@@ -105,8 +106,8 @@ def add_responses(start, work, m):
 def held_rhs(y, model, pts, idx, m, work, dy):
     """dy/dt of the held motion into dy (forces in work.lam)."""
     acc = held_acceleration(y, model, pts, idx, m, work)
-    dy[0], dy[1], dy[2] = y[7], y[8], y[9]
-    dy[3], dy[4], dy[5], dy[6] = quaternion_rate(y)
+    dy[X], dy[Y], dy[Z] = y[VX], y[VY], y[VZ]
+    dy[QW], dy[QX], dy[QY], dy[QZ] = quaternion_rate(y)
     for c in range(6):
         dy[7 + c] = acc[c]
 
@@ -124,8 +125,8 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
         work.r[i] = -normal_velocity(y, contact_frame(y, kind, pts, idx[i]), kind)
     if not solve_small(work.A, work.r, m, work.lam):
         return False
-    y[7], y[8], y[9], y[10], y[11], y[12] = add_responses(
-        (y[7], y[8], y[9], y[10], y[11], y[12]), work, m
+    y[VX], y[VY], y[VZ], y[WX], y[WY], y[WZ] = add_responses(
+        (y[VX], y[VY], y[VZ], y[WX], y[WY], y[WZ]), work, m
     )
     return True
 
@@ -156,9 +157,9 @@ def project_held(y, model, pts, idx, m, work):
         if not solve_small(work.A, work.r, m, work.lam):
             return False
         dx, dy, dz, px, py, pz = add_responses((0.0, 0.0, 0.0, 0.0, 0.0, 0.0), work, m)
-        y[0] += dx
-        y[1] += dy
-        y[2] += dz
+        y[X] += dx
+        y[Y] += dy
+        y[Z] += dz
         rotate_attitude(y, px, py, pz)
     return zero_normal_velocities(y, model, pts, idx, m, work)
 

@@ -3,6 +3,7 @@ frame): inverse inertia in the world frame, the response of (v, ω) to a normal 
 the torque-free angular acceleration, and energies (paper §2.2–2.3)."""
 
 from .jit import hot
+from .layout import VX, VY, VZ, WX, WY, WZ, Z
 from .records import KEEPS_PLANE_MOMENTA, KEEPS_SPIN, Response
 from .rotation import body_axis
 
@@ -48,19 +49,19 @@ def response_rate(f, resp):
 @hot
 def apply_impulse(y, resp, zeta):
     """In place: (v, ω) += ζ M⁻¹Jᵀ."""
-    y[7] += resp.dvx * zeta
-    y[8] += resp.dvy * zeta
-    y[9] += resp.dvz * zeta
-    y[10] += resp.dwx * zeta
-    y[11] += resp.dwy * zeta
-    y[12] += resp.dwz * zeta
+    y[VX] += resp.dvx * zeta
+    y[VY] += resp.dvy * zeta
+    y[VZ] += resp.dvz * zeta
+    y[WX] += resp.dwx * zeta
+    y[WY] += resp.dwy * zeta
+    y[WZ] += resp.dwz * zeta
 
 
 @hot
 def free_angular_acceleration(y, i1, i3):
     """ω̇ without contact forces, −I⁻¹(ω × Iω) (paper eq. acc2free)."""
     e3x, e3y, e3z = body_axis(y)
-    wx, wy, wz = y[10], y[11], y[12]
+    wx, wy, wz = y[WX], y[WY], y[WZ]
     w3 = wx * e3x + wy * e3y + wz * e3z
     Lx = i1 * wx + (i3 - i1) * w3 * e3x
     Ly = i1 * wy + (i3 - i1) * w3 * e3y
@@ -81,9 +82,9 @@ def free_acceleration(y, i1, i3, gravity):
 def kinetic_energy(y, mass, i1, i3):
     """½ m|v|² + ½ (I1 |ω⊥|² + I3 ω3²)."""
     e3x, e3y, e3z = body_axis(y)
-    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
-    ww = y[10] ** 2 + y[11] ** 2 + y[12] ** 2
-    return 0.5 * mass * (y[7] ** 2 + y[8] ** 2 + y[9] ** 2) + 0.5 * (
+    w3 = y[WX] * e3x + y[WY] * e3y + y[WZ] * e3z
+    ww = y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2
+    return 0.5 * mass * (y[VX] ** 2 + y[VY] ** 2 + y[VZ] ** 2) + 0.5 * (
         i1 * (ww - w3 * w3) + i3 * w3 * w3
     )
 
@@ -91,7 +92,7 @@ def kinetic_energy(y, mass, i1, i3):
 @hot
 def potential_energy(y, mass, gravity):
     """m g z."""
-    return mass * gravity * y[2]
+    return mass * gravity * y[Z]
 
 
 @hot
@@ -102,10 +103,10 @@ def excess_energy(y, invariants, mass, i1, i3, gravity):
     along e3), E − ½ I3 ω3²; neither, E."""
     e = kinetic_energy(y, mass, i1, i3) + potential_energy(y, mass, gravity)
     e3x, e3y, e3z = body_axis(y)
-    w3 = y[10] * e3x + y[11] * e3y + y[12] * e3z
+    w3 = y[WX] * e3x + y[WY] * e3y + y[WZ] * e3z
     if invariants & KEEPS_PLANE_MOMENTA:
-        lz = i1 * y[12] + (i3 - i1) * w3 * e3z
-        e = e - 0.5 * mass * (y[7] ** 2 + y[8] ** 2) - lz * lz / (2.0 * i3)
+        lz = i1 * y[WZ] + (i3 - i1) * w3 * e3z
+        e = e - 0.5 * mass * (y[VX] ** 2 + y[VY] ** 2) - lz * lz / (2.0 * i3)
     if invariants & KEEPS_SPIN:
         e = e - 0.5 * i3 * w3 * w3
     return e

@@ -28,6 +28,7 @@ from .contacts import off_face
 from .events import end_run, start
 from .inertia import excess_energy
 from .jit import hot
+from .layout import QX, QY, STATE_SIZE
 from .output import Output
 from .phases import (
     NEEDS_ROWS,
@@ -97,7 +98,7 @@ def _below_tilt_floor(state, y, out):
     contacts."""
     if out.counts[N_IMPACTS] == 0:
         return False
-    h = math.hypot(y[4], y[5])
+    h = math.hypot(y[QX], y[QY])
     return h < 0.5 * TILT_FLOOR and (h > 0.0 or state.n_active > 0)
 
 
@@ -143,7 +144,7 @@ def _rows_short(out):
 
 @hot
 def _finite(y):
-    for c in range(13):
+    for c in range(STATE_SIZE):
         if not math.isfinite(y[c]):
             return False
     return True

@@ -36,6 +36,7 @@ from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
 from .jit import copy_into, hot
+from .layout import VX, VY, VZ, WX, WY, WZ
 from .output import push_phase, push_sample
 from .records import (
     EVENT_ACTIVATION,
@@ -326,7 +327,7 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     for i in range(m):  # the held forces now (ws.lam is reused below)
         ws.lam_chunk[i] = ws.lam[i]
         ws.lam_cur[i] = ws.lam[i]
-    acc = (ws.f[7], ws.f[8], ws.f[9], ws.f[10], ws.f[11], ws.f[12])
+    acc = (ws.f[VX], ws.f[VY], ws.f[VZ], ws.f[WX], ws.f[WY], ws.f[WZ])
     ex = touching_candidates(state, model, pts, opts, acc, cs, gap_res)
     if _touching_event(state, model, pts, opts, stats, out, ws, cs, ex.n, gap_res):
         return DONE

@@ -6,6 +6,8 @@ from collections import namedtuple
 
 import numpy as np
 
+from .layout import STATE_SIZE
+
 # ----------------------------------------------------------------------------- results
 
 # A contact's geometry at a state: gap, unit normal n, lever r (contact point − centre of
@@ -84,7 +86,7 @@ OPTIONS = np.dtype(
 # The loop's state: everything needed to resume it after it returns to Python.
 STATE = np.dtype(
     [
-        ("y", np.float64, (13,)),  # x, q (w, x, y, z), v, ω (world)
+        ("y", np.float64, (STATE_SIZE,)),  # x, q (w, x, y, z), v, ω (world): layout.py
         ("t_hi", np.float64),  # time as a double-double t_hi + t_lo
         ("t_lo", np.float64),
         ("excess0", np.float64),  # initial energy above the resting level
@@ -161,20 +163,20 @@ SCRATCH = np.dtype(
         ("sel", np.int64, (3,)),  # and its contacts
         ("resp", np.float64, (3, 7)),  # M⁻¹J_iᵀ and w_i per contact
         ("geo", np.float64, (3, 6)),  # normal and lever per contact
-        ("K", np.float64, (16, 13)),  # DOP853 stages, f(y_new), dense-output stages
-        ("F", np.float64, (7, 13)),  # dense-output coefficients of a step
-        ("Ks", np.float64, (13, 13)),  # stages of one-step evaluations
-        ("f", np.float64, (13,)),
-        ("y_new", np.float64, (13,)),
-        ("ys", np.float64, (13,)),
-        ("scale", np.float64, (13,)),
-        ("tmp", np.float64, (13,)),
+        ("K", np.float64, (16, STATE_SIZE)),  # DOP853 stages, f(y_new), dense-output stages
+        ("F", np.float64, (7, STATE_SIZE)),  # dense-output coefficients of a step
+        ("Ks", np.float64, (13, STATE_SIZE)),  # stages of one-step evaluations
+        ("f", np.float64, (STATE_SIZE,)),
+        ("y_new", np.float64, (STATE_SIZE,)),
+        ("ys", np.float64, (STATE_SIZE,)),
+        ("scale", np.float64, (STATE_SIZE,)),
+        ("tmp", np.float64, (STATE_SIZE,)),
         ("lam_cur", np.float64, (3,)),  # held forces at the current state
         ("lam_new", np.float64, (3,)),  # held forces at the end of the step accepted
-        ("y_event", np.float64, (13,)),
-        ("y_chunk", np.float64, (13,)),
-        ("y_start", np.float64, (13,)),
-        ("atol", np.float64, (13,)),
+        ("y_event", np.float64, (STATE_SIZE,)),
+        ("y_chunk", np.float64, (STATE_SIZE,)),
+        ("y_start", np.float64, (STATE_SIZE,)),
+        ("atol", np.float64, (STATE_SIZE,)),
         ("res", np.float64, (5,)),  # the search's step / hit / landing bookkeeping
         ("cand", np.int64, (4,)),  # candidates of an impact or activation
         ("active", np.int64, (4,)),  # the LCP's answer

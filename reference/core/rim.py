@@ -10,6 +10,7 @@ import math
 
 from .flight import centre_height, precession_axis, rodrigues_parts
 from .jit import hot
+from .layout import VZ, Z
 from .roots import quadratic_first_root
 from .rotation import body_axis
 from .tolerances import (
@@ -56,7 +57,7 @@ def far_from_ground(y, jet, model):
     """Whether the circle through the vertices is far from the ground (`rim_clear`), its
     lowest point z − |p| with |p| = a sin α (`circle_step`)."""
     px, py = jet[0], jet[1]
-    return rim_clear(y[2], math.sqrt(px * px + py * py), model)
+    return rim_clear(y[Z], math.sqrt(px * px + py * py), model)
 
 
 @hot
@@ -79,7 +80,7 @@ def circle_step(y, jet, g, B):
     rate and acceleration of the body points (a, 0), (0, a) less the centre's.  Over
     |c| = 1, P3_c ≥ F(δ) = Z3(δ) − |p + δ q| − δ²|r|/2 (`circle_root`)."""
     px, py, qx, qy, rx, ry = jet
-    return circle_root(y[2], y[9], g, B, px, py, qx, qy, math.sqrt(rx * rx + ry * ry))
+    return circle_root(y[Z], y[VZ], g, B, px, py, qx, qy, math.sqrt(rx * rx + ry * ry))
 
 
 @hot
@@ -167,7 +168,7 @@ def rim_step(y, gravity, depth, radius):
     than `depth` (Bounds.depth) below the centre, whose height is a parabola, so none
     touches before z + v_z δ − g δ²/2 = depth (`rim_root`).  Near the exact landing
     time of a spinning disk, whose rim's lowest point does not move with the spin."""
-    return rim_root(y[2], y[9], gravity, depth, radius)
+    return rim_root(y[Z], y[VZ], gravity, depth, radius)
 
 
 @hot
@@ -201,7 +202,7 @@ def rim_at(y, cone, model, s):
     ux, uy, cx, cy, wx, wy, om, _ = cone
     a = model.radius
     co, si = math.cos(om * s), math.sin(om * s)
-    z, vz = centre_height(y[2], y[9], model.gravity, s)
+    z, vz = centre_height(y[Z], y[VZ], model.gravity, s)
     return (
         z,
         vz,

@@ -1,11 +1,13 @@
 """Quaternion primitives for one state (scalars, compiled).  Unit quaternions
-(w, x, y, z), body → world, at y[3:7] of a state.  Small rotations keep their digits:
-sin(θ/2)/θ from its series near 0, and the tilt terms of R from the small quaternion
-components directly (reference.quaternion is the same library for arrays)."""
+(w, x, y, z), body → world, at y[QUATERNION] of a state (reference.core.layout).
+Small rotations keep their digits: sin(θ/2)/θ from its series near 0, and the tilt
+terms of R from the small quaternion components directly (reference.quaternion is the
+same library for arrays)."""
 
 import math
 
 from .jit import hot
+from .layout import QW, QX, QY, QZ, WX, WY, WZ
 
 HALF_SINC_SERIES_BELOW = 1e-4  # the series' next term, θ⁶/645120, is < 1e-30 there
 
@@ -43,7 +45,7 @@ def rotate_attitude(y, px, py, pz):
     """In place: the attitude of state y turned by the world rotation vector p,
     q ← normalize(exp(p) ⊗ q)."""
     a0, a1, a2, a3 = rotation_vector_quaternion(px, py, pz)
-    q0, q1, q2, q3 = qmul(a0, a1, a2, a3, y[3], y[4], y[5], y[6])
+    q0, q1, q2, q3 = qmul(a0, a1, a2, a3, y[QW], y[QX], y[QY], y[QZ])
     set_attitude(y, q0, q1, q2, q3)
 
 
@@ -51,7 +53,7 @@ def rotate_attitude(y, px, py, pz):
 def set_attitude(y, q0, q1, q2, q3):
     """In place: y's quaternion ← (q0, q1, q2, q3) normalised."""
     nq = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    y[3], y[4], y[5], y[6] = q0 / nq, q1 / nq, q2 / nq, q3 / nq
+    y[QW], y[QX], y[QY], y[QZ] = q0 / nq, q1 / nq, q2 / nq, q3 / nq
 
 
 @hot
@@ -64,14 +66,14 @@ def axis_of(w, x, yq, z):
 @hot
 def body_axis(y):
     """e3 of state y."""
-    return axis_of(y[3], y[4], y[5], y[6])
+    return axis_of(y[QW], y[QX], y[QY], y[QZ])
 
 
 @hot
 def rotation_columns_xy(y):
     """The first two columns of R: (R00, R01, R10, R11, R20, R21); the z row (the tilt
     terms) from the small quaternion components directly."""
-    w, x, yq, z = y[3], y[4], y[5], y[6]
+    w, x, yq, z = y[QW], y[QX], y[QY], y[QZ]
     return (
         1 - 2 * (yq * yq + z * z),
         2 * (x * yq - w * z),
@@ -84,9 +86,9 @@ def rotation_columns_xy(y):
 
 @hot
 def quaternion_rate(y):
-    """dq/dt = ½ (0, ω) ⊗ q for the world angular velocity ω = y[10:13]."""
-    wx, wy, wz = y[10], y[11], y[12]
-    w, x, yq, z = y[3], y[4], y[5], y[6]
+    """dq/dt = ½ (0, ω) ⊗ q for the world angular velocity ω = y[ANGULAR_VELOCITY]."""
+    wx, wy, wz = y[WX], y[WY], y[WZ]
+    w, x, yq, z = y[QW], y[QX], y[QY], y[QZ]
     return (
         0.5 * (-wx * x - wy * yq - wz * z),
         0.5 * (wx * w + wy * z - wz * yq),

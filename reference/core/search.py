@@ -25,6 +25,7 @@ from .contacts import (
     contact_jet,
     contact_kind,
     frame_and_rate,
+    kind_in_ground,
     normal_acceleration,
     rate_noise,
     reached_together,
@@ -33,11 +34,13 @@ from .contacts import (
 )
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
 from .jit import copy_into, hot
+from .layout import VZ, Z
 from .records import (
     EVENT_ACTIVATION,
     EVENT_IMPACT,
     EVENT_NONE,
     EVENT_STUCK,
+    FLOOR_POINT_ON_FACE,
     RIM_VERTEX_ON_PLANE,
     FlightEvent,
     Jet,
@@ -122,8 +125,8 @@ def likely_binding(y, jet, pts, n, K, first, count, radius, best_d):
     best = k = first % n
     for _ in range(count):
         cx, cy = pts[k, 0] * inv_a, pts[k, 1] * inv_a
-        g = max(y[2] + cx * px + cy * py, TINY)
-        g1 = y[9] + cx * qx + cy * qy
+        g = max(y[Z] + cx * px + cy * py, TINY)
+        g1 = y[VZ] + cx * qx + cy * qy
         if not p2_positive_at(g, g1, K, best_d):  # (else it cannot come first)
             d = quadratic_first_root(g, g1, K)
             if d < best_d:
@@ -181,10 +184,13 @@ def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise
 @hot
 def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
     """One iteration's certified step (res holds hits and landings): the ground's
-    contacts other than rim vertices one by one, and its rim vertices as a family
-    (`_rim_vertices_step`), the shorter step kept (`_shorter_step`).  Returns (step,
-    last certified window step)."""
+    contacts other than rim vertices one by one (every contact of a ground without rim
+    vertices), then its rim vertices as a family: far from the ground, the circle
+    through them (its step from the rim's jet, then `rim.rim_descent`), else every
+    vertex for small n, or the vertices near the lowest direction; the shorter step of
+    the two kept (`_shorter`).  Returns (step, last certified window step)."""
     n, n_rim = pts.shape[0], model.n_rim
+    K, B = bounds.K, bounds.B
     res[STEP], res[STEP_K], res[HIT_DS], res[HIT_K], res[LAND_K] = (
         math.inf,
         -1.0,
@@ -192,57 +198,43 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
         -1.0,
         -1.0,
     )
-    if n_rim == n:
-        return _rim_vertices_step(
-            y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res
-        )
-    cols = rotation_columns_xy(y)  # (unused by a floor point's frame)
-    for k in range(n_rim, n):
-        examine(y, acc, cols, contact_kind(model, k), pts, k, bounds.K, bounds.B, vnoise, res)
-    if n_rim == 0:
-        return res[STEP], last_dlt
-    return _shorter_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res)
-
-
-@hot
-def _shorter_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
-    """A ground with rim vertices and other contacts (res: the others examined): the
-    shorter of the others' step and the rim vertices' (`_rim_vertices_step`), res[STEP]
-    and res[STEP_K] those of the contact that sets it (the rim's step may exceed its
-    examined vertices' by `rim.rim_step`, which bounds the rim vertices alone)."""
-    other, other_k = res[STEP], res[STEP_K]
-    res[STEP], res[STEP_K] = math.inf, -1.0
-    step, last_dlt = _rim_vertices_step(
-        y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res
-    )
-    if other < step:
-        res[STEP], res[STEP_K] = other, other_k
-        return other, last_dlt
-    return step, last_dlt
-
-
-@hot
-def _rim_vertices_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dlt, res):
-    """The step certified for the rim vertices 0 … n_rim − 1 (into res): far from the
-    ground, the circle through them (its step from the rim's jet, then
-    `rim.rim_descent`), else every vertex for small n, or the vertices near the lowest
-    direction.  Returns (step, last certified window step)."""
-    n = model.n_rim
-    K, B = bounds.K, bounds.B
+    other, other_k = math.inf, -1.0
+    if n_rim < n:
+        cols = rotation_columns_xy(y)  # (unused by a floor point's frame)
+        for k in range(n_rim, n):  # the floor points (`contacts.kind_in_ground`)
+            examine(y, acc, cols, FLOOR_POINT_ON_FACE, pts, k, K, B, vnoise, res)
+        if n_rim == 0:
+            return res[STEP], last_dlt
+        other, other_k = res[STEP], res[STEP_K]
+        res[STEP], res[STEP_K] = math.inf, -1.0
     jet = rim_jet(y, acc, model.radius)  # shared by the circle step and the orderings
     rim = rim_step(y, model.gravity, bounds.depth, model.radius)
     if far_from_ground(y, jet, model):
         d_c = max(circle_step(y, jet, model.gravity, B), rim)
-        if lands_near(jet, B, d_c, model):
-            return d_c, last_dlt
-        return rim_descent(y, fc, model, bounds.depth, left, d_c), last_dlt
+        if not lands_near(jet, B, d_c, model):
+            d_c = rim_descent(y, fc, model, bounds.depth, left, d_c)
+        return _shorter(d_c, other, other_k, res), last_dlt
     if not windowed:
-        examine_range(y, acc, jet, pts, n, K, B, 0, n, vnoise, res, model.radius)
-        return max(res[STEP], rim), last_dlt
-    cap = near_vertices_step(y, acc, jet, pts, model.radius, n, K, B, left, last_dlt, vnoise, res)
+        examine_range(y, acc, jet, pts, n_rim, K, B, 0, n_rim, vnoise, res, model.radius)
+        return _shorter(max(res[STEP], rim), other, other_k, res), last_dlt
+    cap = near_vertices_step(
+        y, acc, jet, pts, model.radius, n_rim, K, B, left, last_dlt, vnoise, res
+    )
     if cap < math.inf:
         last_dlt = cap
-    return max(min(res[STEP], cap), rim), last_dlt
+    return _shorter(max(min(res[STEP], cap), rim), other, other_k, res), last_dlt
+
+
+@hot
+def _shorter(step, other, other_k, res):
+    """The shorter of the rim vertices' step and the other contacts' (`other`, set by
+    contact other_k; inf when the ground has none), res[STEP] and res[STEP_K] those of
+    the other contact when it sets it (the rim's step may exceed its examined vertices'
+    by `rim.rim_step`, which bounds the rim vertices alone)."""
+    if other < step:
+        res[STEP], res[STEP_K] = other, other_k
+        return other
+    return step
 
 
 @hot
@@ -260,13 +252,14 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
     t = end
+    n_rim = model.n_rim
     cols = rotation_columns_xy(y)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, j = next_index(nxt, n), nxt
         if j == k:
             continue
-        kind = contact_kind(model, j)
+        kind = kind_in_ground(n_rim, j)
         f, rate = frame_and_rate(y, cols, kind, pts, j)
         g = f.gap
         if g <= f.noise:
@@ -382,14 +375,14 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
     tres0 = time_resolution(f0.noise, rate0)
     together[0] = k0
     count = 1
-    n = pts.shape[0]
+    n, n_rim = pts.shape[0], model.n_rim
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
         if k == k0:
             continue
-        f, rate = frame_and_rate(y, cols, contact_kind(model, k), pts, k)
+        f, rate = frame_and_rate(y, cols, kind_in_ground(n_rim, k), pts, k)
         if rate >= -vnoise:
             continue
         if reached_together(f.gap, rate, f.noise, tres0):
@@ -402,12 +395,12 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
 def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     """Contacts touching at rest and accelerating into the ground at state y."""
     count = 0
-    n = pts.shape[0]
+    n, n_rim = pts.shape[0], model.n_rim
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
-        j = contact_jet(y, contact_kind(model, k), pts, k, acc)
+        j = contact_jet(y, kind_in_ground(n_rim, k), pts, k, acc)
         if j.gap <= j.noise and j.rate <= vnoise and j.accel < 0:
             together[count] = k
             count += 1

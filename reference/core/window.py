@@ -11,6 +11,7 @@ that does not grow with n."""
 import math
 
 from .jit import hot
+from .layout import VZ, WX, WY, Z
 from .rotation import rotation_columns_xy
 from .tolerances import ANGLE_ERROR, SMALL_N
 
@@ -39,17 +40,17 @@ def vertex_window(y, radius, n, K, delta, margin, lift=0.0):
     π − acos((lift − Z)/(a|u|)) around ∠u + π (∠u to ANGLE_ERROR, `direction_angle`,
     which the half-width takes in).  half = n // 2 means every vertex."""
     R00, R01, R10, R11, R20, R21 = rotation_columns_xy(y)
-    A = y[10] * R10 - y[11] * R00
-    Bq = y[10] * R11 - y[11] * R01
+    A = y[WX] * R10 - y[WY] * R00
+    Bq = y[WX] * R11 - y[WY] * R01
     ux, uy = R20 + A * delta, R21 + Bq * delta
     U = math.sqrt(ux * ux + uy * uy)
-    Z = y[2] + y[9] * delta - 0.5 * K * delta * delta - lift
+    Zd = y[Z] + y[VZ] * delta - 0.5 * K * delta * delta - lift
     dth = 2.0 * math.pi / n
     centre = direction_angle(ux, uy) + math.pi
-    if radius * U <= 0.0 or -Z / (radius * U) <= -1.0:
+    if radius * U <= 0.0 or -Zd / (radius * U) <= -1.0:
         half = 0
     else:
-        c = -Z / (radius * U)
+        c = -Zd / (radius * U)
         W = math.pi if c >= 1.0 else math.pi - math.acos(c)
         half = int(math.ceil((W + ANGLE_ERROR) / dth))
     half = min(half + margin, n // 2)

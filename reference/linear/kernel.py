@@ -59,7 +59,9 @@ import numpy as np
 from numba import njit
 
 from ..core.clock import time_until
+from ..core.impact import bounce_ratio, chatter_impulse, impact_impulse, post_impact_velocity
 from ..core.tolerances import EPS  # unit roundoff of a double (one definition)
+from .model import energy as model_energy
 
 # The event loop's helpers allocate nothing: they are compiled inline into simulate_kernel
 # (LLVM alwaysinline) and without reference counting (numba's own idiom for allocation-free
@@ -79,6 +81,19 @@ F_DT, F_DTN, F_THI, F_TLO, F_IMPULSE, F_VPRE, F_VPOST, F_EPRE, F_EPOST, F_LOG2E 
 N_FCOLS = 10
 # state columns (normalised): q_pre, p_pre, q_post, p_post, acceleration that follows
 N_SCOLS = 15
+# why a run stopped (info[5]), named like the exact core's statuses
+# (reference.core.records.STATUS_*); messages: simulate.REASON_MESSAGES
+REASON_NONE = 0  # t_end or max_impacts
+REASON_SIMULTANEOUS = 1  # two contacts reached at once
+REASON_PUSHED = 2  # an impact would drive a held contact into the ground
+REASON_NO_ENERGY = 3  # the energy is exhausted (E ≤ 0)
+REASON_ENERGY_EXHAUSTED = 4  # the energy fell below the floor
+REASON_CHATTER_SIMULTANEOUS = 5  # a contact at the ground when a chatter accumulates
+REASON_CHATTER2_SIMULTANEOUS = 6  # the same for a two-contact chatter
+REASON_SINGULARITY = 7  # all contacts down (rank(F) closed)
+REASON_FAILED_LCP = 8  # no admissible set of held contacts
+REASON_BUFFER_FULL = 9  # the event buffer is full
+REASON_FAILED_NO_ADVANCE = 10  # no further event and no end time
 N_INFO = 8  # status, n_events, n_impacts, contact_a, contact_b, reason
 RB = 64  # ring buffer of recent impacts
 # integer run state `si`: scale exponents kv, kq; rows written; impacts resolved; ring
@@ -181,12 +196,8 @@ def _project(x, F, tinv, idx, m):
         x[i] -= tinv[i] * (F[i0, i] * lam0 + F[i1, i] * lam1)
 
 
-@njit(cache=True)
-def _energy(q, p, thd, mass, g):
-    """½ pᵀΘp + m g h."""
-    return 0.5 * (thd[0] * p[0] * p[0] + thd[1] * p[1] * p[1] + thd[2] * p[2] * p[2]) + (
-        mass * g * q[2]
-    )
+# ½ pᵀΘp + m g h (model.energy, compiled)
+_energy = njit(cache=True)(model_energy)
 
 
 @_helper
@@ -404,7 +415,7 @@ def _record_held_set(out, row, held, acc):
 
 @_helper
 def _stop(si, info, status, reason, c1, c2):
-    """End the run with `status` and `reason` (codes as simulate._REASONS); c1, c2 ≥ 0
+    """End the run with `status` and `reason` (REASON_*); c1, c2 ≥ 0
     are the two contacts of an undecidable event (the paper, section 2.3)."""
     si[SI_STATUS] = status
     si[SI_REASON] = reason
@@ -487,11 +498,12 @@ def _any_closed(closed):
 
 @_helper
 def _apply_impulse(F, tinv, w, gamma, j, q, p, q_pre, p_pre):
-    """Impact at contact j (the paper, section 2.5, eqs. impactmap and impactequ):
-    λ = −(1+γ) f_jᵀp⁻ / f_jᵀΘ⁻¹f_j, p⁺ = p⁻ + Θ⁻¹f_j λ; q, p before into q_pre, p_pre.
-    Returns (f_jᵀp⁻, λ)."""
+    """Impact at contact j (the paper, section 2.5, eqs. impactmap and impactequ): the
+    exact core's law, λ = (u⁺ − u⁻)/f_jᵀΘ⁻¹f_j with u⁻ = f_jᵀp⁻
+    (reference.core.impact.impact_impulse: −(1+γ) u⁻/w for Newton's law),
+    p⁺ = p⁻ + Θ⁻¹f_j λ; q, p before into q_pre, p_pre.  Returns (u⁻, λ)."""
     vpre = _dot(F, j, p)
-    lam = -(1.0 + gamma) * vpre / w[j, j]
+    lam = impact_impulse(vpre, w[j, j], gamma)
     for i in range(3):
         q_pre[i] = q[i]
         p_pre[i] = p[i]
@@ -525,7 +537,7 @@ def _hold_after_impact(F, tinv, gamma, j, p, closed, hidx):
     """After a plastic impact (γ = 0, the paper, section 2.3, eq. utk3) contact j stays
     down; p is projected onto the closed contacts (at most three; sustained contacts,
     section 2.2), whose normal velocities are then exactly 0."""
-    if gamma == 0.0:
+    if bounce_ratio(gamma) == 0.0:
         closed[j] = True
     nh = _closed_indices(closed, hidx, 3)
     if nh > 0:
@@ -550,7 +562,7 @@ def _remember_impact(ring, si, j, dtn, vpre):
 @_helper
 def _resolve_impact(model, state, scratch, ring, out, si, sf, info, j, E, vfl):
     """Impact at contact j with energy E before it (the paper, sections 2.3 and 2.5):
-    the impact map, the rule for held contacts (else SIMULTANEOUS, reason 2, state
+    the impact map, the rule for held contacts (else SIMULTANEOUS, REASON_PUSHED, state
     before the impact kept), the IMPACT row, the ring buffer and the renormalisation.
     Returns the approach velocity f_jᵀp⁻ in the new scales."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
@@ -561,10 +573,10 @@ def _resolve_impact(model, state, scratch, ring, out, si, sf, info, j, E, vfl):
     if bad >= 0:
         for i in range(3):
             p[i] = p_pre[i]  # report the state before the undecidable impact
-        _stop(si, info, SIMULTANEOUS, 2, j, bad)
+        _stop(si, info, SIMULTANEOUS, REASON_PUSHED, j, bad)
         return vpre
     _hold_after_impact(F, tinv, gamma, j, p, closed, hidx)
-    vpost = -gamma * vpre if gamma > 0.0 else _dot(F, j, p)
+    vpost = post_impact_velocity(vpre, gamma) if bounce_ratio(gamma) > 0.0 else _dot(F, j, p)
     for i in range(3):
         ps[i] = abs(p_pre[i]) + abs(p[i])
     si[SI_IMPACTS] += 1
@@ -586,24 +598,24 @@ def _resolve_impact(model, state, scratch, ring, out, si, sf, info, j, E, vfl):
 @_helper
 def _impact_step(model, limits, state, scratch, ring, out, si, sf, info, j, E, vfl):
     """An impact at contact j now: stop at max_impacts (or a full event buffer), resolve
-    the impact, stop once the energy is exhausted (reason 3) or below the floor (reason
-    4: the singularity, the paper, section 1), then complete a chatter sequence in free
-    flight (0 < γ < 1) where possible."""
+    the impact, stop once the energy is exhausted (REASON_NO_ENERGY) or below the floor
+    (REASON_ENERGY_EXHAUSTED: the singularity, the paper, section 1), then complete a
+    chatter sequence in free flight (0 < γ < 1) where possible."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
     t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol = limits
     q, p, qs, ps, acc, held, closed = state
     if si[SI_IMPACTS] >= max_impacts or si[SI_EVENTS] + 3 >= out[0].shape[0]:
-        _stop(si, info, MAX_IMPACTS, 0, -1, -1)
+        _stop(si, info, MAX_IMPACTS, REASON_NONE, -1, -1)
         return
     vpre = _resolve_impact(model, state, scratch, ring, out, si, sf, info, j, E, vfl)
     if si[SI_STATUS] >= 0:
         return
     E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
     if not (E > 0.0):
-        _stop(si, info, SINGULARITY, 3, -1, -1)
+        _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
     elif math.log2(E) + 2 * si[SI_KV] <= log2_energy_floor:
-        _stop(si, info, SINGULARITY, 4, -1, -1)
-    elif 0.0 < gamma < 1.0 and not _any_closed(closed):
+        _stop(si, info, SINGULARITY, REASON_ENERGY_EXHAUSTED, -1, -1)
+    elif 0.0 < bounce_ratio(gamma) < 1.0 and not _any_closed(closed):
         _complete_chatter(model, limits, state, scratch, ring, out, si, sf, info, j, E, vpre)
 
 
@@ -666,8 +678,9 @@ def _recent_partner(rb_c, pos, j):
 def _alone_until_accumulation(F, w, q, p, qs, j, gamma, gt, T, vplus):
     """Whether no contact but j can reach the ground within the remaining duration T of
     j's chatter: gap_c − T (|v_c| + g T + |w_cj| Λ) above roundoff for every other c, with
-    Λ = (1+γ) v⁺ / (w_jj (1−γ)) the total impulse still to come (module docstring)."""
-    lam_tot = (1.0 + gamma) * vplus / (w[j, j] * (1.0 - gamma))
+    Λ the total impulse still to come (reference.core.impact.chatter_impulse: (1+γ) v⁺ /
+    (w_jj (1−γ)) for Newton's law; module docstring)."""
+    lam_tot = chatter_impulse(vplus, w[j, j], gamma)
     for c in range(F.shape[0]):
         if c == j:
             continue
@@ -713,7 +726,7 @@ def _chatter_plan(model, limits, state, sidx, ring, si, sf, j, E, vpre):
     vplus = _dot(F, j, p)
     vel_scale = _velocity_scale(E, wmax)
     rem = _time_left(t_end, sf[SF_T_HI], sf[SF_T_LO], si[SI_KV], si[SI_KQ])
-    fall = gt * (1.0 - gamma)  # may underflow when gravity is negligible
+    fall = gt * (1.0 - bounce_ratio(gamma))  # may underflow when gravity is negligible
     T = 2.0 * vplus / fall if fall > 0.0 else math.inf
     sidx[0] = j
     sidx[1] = -1
@@ -781,13 +794,15 @@ def _accumulate(model, state, scratch, out, si, sf, j, m_s, T, E, vpre):
 @_helper
 def _check_accumulation(F, q, qs, closed, si, info, j, m_s):
     """After a completion without proof: another contact at the ground within roundoff
-    makes the accumulation undecidable (SIMULTANEOUS; reason 5 for one chattering
-    contact, 6 for two; the last such contact is reported)."""
+    makes the accumulation undecidable (SIMULTANEOUS; REASON_CHATTER_SIMULTANEOUS for
+    one chattering contact, REASON_CHATTER2_SIMULTANEOUS for two; the last such contact
+    is reported)."""
     for c in range(F.shape[0]):
         if closed[c]:
             continue
         if _touching(F, c, q, qs):
-            _stop(si, info, SIMULTANEOUS, 5 if m_s == 1 else 6, j, c)
+            reason = REASON_CHATTER_SIMULTANEOUS if m_s == 1 else REASON_CHATTER2_SIMULTANEOUS
+            _stop(si, info, SIMULTANEOUS, reason, j, c)
 
 
 @_helper
@@ -834,24 +849,24 @@ def _touch_down(F, q, p, qs, ps, acc, closed, vfl):
 def _settle_held_set(model, state, cidx, gt, vfl):
     """Re-solve the held set at an event (module docstring; sustained contacts: the
     paper, sections 2.2 and 2.5, eq. pacccontact): held contacts and acceleration into
-    state, up to four rounds of lift-off and touch-down.  Returns 0, or the reason to
-    stop: 7 when rank(F) contacts are closed (the body lies on the ground, section 2.2),
-    8 when no held subset is admissible."""
+    state, up to four rounds of lift-off and touch-down.  Returns REASON_NONE, or the
+    reason to stop: REASON_SINGULARITY when rank(F) contacts are closed (the body lies on
+    the ground, section 2.2), REASON_FAILED_LCP when no held subset is admissible."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
     q, p, qs, ps, acc, held, closed = state
     ncl = _closed_indices(closed, cidx, F.shape[0])
     if ncl >= rank_f:
-        return 7
+        return REASON_SINGULARITY
     for _it in range(4):
         if _held_solve(F, tinv, gt, cidx, ncl, acc, held) < 0:
-            return 8
+            return REASON_FAILED_LCP
         _lift_off(F, cidx, ncl, held, acc, closed)
         if not _touch_down(F, q, p, qs, ps, acc, closed, vfl):
-            return 0
+            return REASON_NONE
         ncl = _closed_indices(closed, cidx, F.shape[0])
         if ncl >= rank_f:
-            return 7
-    return 0
+            return REASON_SINGULARITY
+    return REASON_NONE
 
 
 @_helper
@@ -930,8 +945,9 @@ def _flight_step(model, limits, state, scratch, out, si, sf, info, vfl):
     q, p, qs, ps, acc, held, closed = state
     hidx = scratch[6]
     reason = _settle_held_set(model, state, scratch[5], sf[SF_GRAVITY], vfl)
-    if reason != 0:
-        _stop(si, info, SINGULARITY if reason == 7 else FAILED, reason, -1, -1)
+    if reason != REASON_NONE:
+        status = SINGULARITY if reason == REASON_SINGULARITY else FAILED
+        _stop(si, info, status, reason, -1, -1)
         return
     _record_held_set(out, si[SI_EVENTS] - 1, held, acc)
     nh = _held_indices(held, hidx)
@@ -939,7 +955,7 @@ def _flight_step(model, limits, state, scratch, out, si, sf, info, vfl):
     rem = _time_left(t_end, sf[SF_T_HI], sf[SF_T_LO], si[SI_KV], si[SI_KQ])
     if tmin >= rem or jmin < 0:
         if not math.isfinite(rem):
-            _stop(si, info, FAILED, 10, -1, -1)
+            _stop(si, info, FAILED, REASON_FAILED_NO_ADVANCE, -1, -1)
             return
         tmin = max(rem, 0.0)
         jmin = -1
@@ -973,7 +989,7 @@ def _step(model, limits, state, scratch, ring, out, si, sf, info):
     vfl = _velocity_scale(E, wmax)
     ncand, cand, cand2 = _impacts_now(F, q, p, qs, ps, closed, vfl)
     if ncand >= 2:
-        _stop(si, info, SIMULTANEOUS, 1, cand, cand2)
+        _stop(si, info, SIMULTANEOUS, REASON_SIMULTANEOUS, cand, cand2)
     elif ncand == 1:
         _impact_step(model, limits, state, scratch, ring, out, si, sf, info, cand, E, vfl)
     else:
@@ -1060,7 +1076,7 @@ def simulate_kernel(
     if not (E > 0.0):
         _write_state_row(out, 0, INITIAL, si, held, 0.0, 0.0, 0.0, E, q, p, acc)
         si[SI_EVENTS] = 1
-        _stop(si, info, SINGULARITY, 3, -1, -1)
+        _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
         _write_info(si, info)
         return si[SI_EVENTS]
     _start(model, state, out, si, sf, E)

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core import layout as L
 from ..scene import SceneError
 
 U3 = np.array([0.0, 0.0, 1.0])
@@ -71,9 +72,14 @@ def theta_diag(mass: float, inertia: float) -> np.ndarray:
 
 
 def impact_matrix(f: np.ndarray, theta: np.ndarray, gamma: float) -> np.ndarray:
-    """U = I − (1+γ) Θ⁻¹ f fᵀ / (fᵀ Θ⁻¹ f) (eq. impactequ); `theta` is diag(Θ)."""
+    """U with p⁺ = U p⁻ for an impact at the contact of row f (eq. impactequ; `theta` is
+    diag(Θ)): p⁺ = p⁻ + Θ⁻¹ f λ with the exact core's impulse λ(u⁻) of the normal
+    velocity u⁻ = fᵀp⁻ and w = fᵀ Θ⁻¹ f (reference.core.impact.impact_impulse), linear
+    in u⁻ (Newton's law), so U = I + λ(1) Θ⁻¹ f fᵀ = I − (1+γ) Θ⁻¹ f fᵀ / (fᵀ Θ⁻¹ f)."""
+    from ..core.impact import impact_impulse  # (numba: imported when an impact is formed)
+
     tf = f / theta
-    return np.eye(3) - (1.0 + gamma) * np.outer(tf, f) / float(f @ tf)
+    return np.eye(3) + impact_impulse(1.0, float(f @ tf), gamma) * np.outer(tf, f)
 
 
 def free_acceleration(gravity: float) -> np.ndarray:
@@ -101,9 +107,13 @@ def contact_acceleration(f: np.ndarray, theta: np.ndarray, mass: float, gravity:
     return held_acceleration(f[None, :], theta, mass, gravity)[0]
 
 
-def energy(q: np.ndarray, p: np.ndarray, theta: np.ndarray, mass: float, gravity: float):
-    """E = ½ pᵀΘp + m g h: exactly conserved by the linear flight and contact phases."""
-    return 0.5 * float(p @ (theta * p)) + mass * gravity * float(q[2])
+def energy(q, p, theta, mass: float, gravity: float) -> float:
+    """E = ½ pᵀΘp + m g h: exactly conserved by the linear flight and contact phases.
+    Plain arithmetic on the three components, so that the linear kernel compiles this
+    same function (kernel._energy)."""
+    return 0.5 * (theta[0] * p[0] * p[0] + theta[1] * p[1] * p[1] + theta[2] * p[2] * p[2]) + (
+        mass * gravity * q[2]
+    )
 
 
 @dataclass(frozen=True)
@@ -195,7 +205,7 @@ class LinearModel:
         return free_acceleration(self.gravity)
 
     def energy(self, q, p) -> float:
-        return energy(np.asarray(q), np.asarray(p), self.theta, self.mass, self.gravity)
+        return float(energy(np.asarray(q), np.asarray(p), self.theta, self.mass, self.gravity))
 
     @property
     def rank(self) -> int:
@@ -221,17 +231,17 @@ def full_states(q: np.ndarray, p: np.ndarray) -> np.ndarray:
     q = np.atleast_2d(q)
     p = np.atleast_2d(p)
     N = len(q)
-    y = np.zeros((N, 13))
-    y[:, 2] = q[:, 2]
+    y = np.zeros((N, L.STATE_SIZE))
+    y[:, L.Z] = q[:, 2]
     theta = np.hypot(q[:, 0], q[:, 1])
     small = theta < 1e-4
     t2 = theta * theta
     with np.errstate(invalid="ignore", divide="ignore"):
         hs = np.where(small, 0.5 - t2 / 48.0 + t2 * t2 / 3840.0, np.sin(0.5 * theta) / theta)
-    y[:, 3] = np.cos(0.5 * theta)
-    y[:, 4] = hs * q[:, 0]
-    y[:, 5] = hs * q[:, 1]
-    y[:, 9] = p[:, 2]
-    y[:, 10] = p[:, 0]
-    y[:, 11] = p[:, 1]
+    y[:, L.QW] = np.cos(0.5 * theta)
+    y[:, L.QX] = hs * q[:, 0]
+    y[:, L.QY] = hs * q[:, 1]
+    y[:, L.VZ] = p[:, 2]
+    y[:, L.WX] = p[:, 0]
+    y[:, L.WY] = p[:, 1]
     return y

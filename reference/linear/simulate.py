@@ -76,16 +76,18 @@ class LinearRun:
 
 
 _REASONS = {
-    1: "two contacts reached at once",
-    2: "an impact would drive a resting contact into the ground (paper §2.3)",
-    3: "energy exhausted",
-    4: "energy fell below the floor",
-    5: "a contact is at the ground when a chatter sequence accumulates",
-    6: "a contact is at the ground when a two-contact chatter accumulates",
-    7: "all contacts down",
-    8: "no admissible set of held contacts",
-    9: "event buffer full",
-    10: "no further event and no end time",
+    K.REASON_SIMULTANEOUS: "two contacts reached at once",
+    K.REASON_PUSHED: "an impact would drive a resting contact into the ground (paper §2.3)",
+    K.REASON_NO_ENERGY: "energy exhausted",
+    K.REASON_ENERGY_EXHAUSTED: "energy fell below the floor",
+    K.REASON_CHATTER_SIMULTANEOUS: "a contact is at the ground when a chatter sequence accumulates",
+    K.REASON_CHATTER2_SIMULTANEOUS: (
+        "a contact is at the ground when a two-contact chatter accumulates"
+    ),
+    K.REASON_SINGULARITY: "all contacts down",
+    K.REASON_FAILED_LCP: "no admissible set of held contacts",
+    K.REASON_BUFFER_FULL: "event buffer full",
+    K.REASON_FAILED_NO_ADVANCE: "no further event and no end time",
 }
 
 
@@ -265,7 +267,7 @@ def simulate_linear(
     t_sing = None
     t_final = run.t_final
     if run.status is Status.SINGULARITY:
-        if run.reason == 7:
+        if run.reason == K.REASON_SINGULARITY:
             t_sing = t_final
         else:
             rem = extrapolate_time_to_go(run.log2_dt, run.log2_energy)
@@ -426,7 +428,7 @@ def run_linear_exponent(
         return out
     ex = exponent_of_run(run)
     if run.status is Status.SINGULARITY:
-        if run.reason == 7:
+        if run.reason == K.REASON_SINGULARITY:
             out["t_singularity"] = run.t_final
         elif ex["log2_time_remaining"] is not None:
             out["t_singularity"] = run.t_final + 2.0 ** ex["log2_time_remaining"]
