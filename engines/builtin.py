@@ -20,6 +20,8 @@ from .interface import engine_entry
 # PyBullet 136 s for two (measured); at 1e4 both run (0.8 s and 3.2 s for 100 steps).
 # Linear model: O(n^2) memory, 0.93 GB at n = 1e4.
 MAX_VERTICES = 10_000
+# The linear model's grounds (reference.linear.model.NO_MIXED_GROUND: not bumpy).
+LINEAR_GROUNDS = ("flat", "three_point")
 
 
 def _profile(
@@ -51,7 +53,7 @@ def reference(scene: Scene, *, dt: float | None = None, t_end: float | None = No
     return simulate(scene, t_end=t_end)
 
 
-@engine_entry(fixed_step=False, max_vertices=MAX_VERTICES)
+@engine_entry(fixed_step=False, max_vertices=MAX_VERTICES, ground_kinds=LINEAR_GROUNDS)
 def linear(scene: Scene, *, dt: float | None = None, t_end: float | None = None) -> Trajectory:
     """The paper's linear model, exact event-driven (dt does not apply)."""
     from reference.linear.simulate import simulate_linear

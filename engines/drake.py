@@ -9,6 +9,9 @@ signed distance is the reference's gap z + (R p_k)_z exactly and the force acts 
 ẑ through the vertex.  `three_point`: a sphere of radius r at every bump b_k (z = 0,
 fixed to the world) and on the body a box whose bottom face lies at body height +r, so
 sphere–face distance = (x − b_k)·e3, the reference's gap, and the normal is e3.
+`bumpy` (both kinds): the half space with the vertex spheres and the bump spheres (at
+their heights) with the face box; a SceneGraph collision filter excludes the face–half
+space and vertex–bump pairs, so each body geometry meets only its own kind's partner.
 
 Contact law (Drake's "Contact Modeling" documentation, multibody/plant): point contact
 force fₙ = k x (1 + d ẋ)₊ (x penetration, ẋ its rate; Hunt & Crossley dissipation d in
@@ -295,7 +298,7 @@ def _proximity(stiffness: float, dissipation: float, relaxation: float | None):
 
 def build_model(scene: Scene, settings: DrakeSettings) -> DrakeModel:
     """The scene's diagram (MultibodyPlant + SceneGraph) under the settings."""
-    from pydrake.geometry import Box, HalfSpace, Sphere
+    from pydrake.geometry import Box, CollisionFilterDeclaration, GeometrySet, HalfSpace, Sphere
     from pydrake.math import RigidTransform
     from pydrake.multibody.plant import (
         AddMultibodyPlantSceneGraph,
@@ -306,7 +309,7 @@ def build_model(scene: Scene, settings: DrakeSettings) -> DrakeModel:
     from pydrake.systems.framework import DiagramBuilder
 
     builder = DiagramBuilder()
-    plant, _ = AddMultibodyPlantSceneGraph(builder, settings.time_step)
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, settings.time_step)
     plant.set_contact_model(ContactModel.kPoint)
     if settings.time_step > 0:
         plant.set_discrete_contact_approximation(DiscreteContactApproximation.kSap)
@@ -326,26 +329,39 @@ def build_model(scene: Scene, settings: DrakeSettings) -> DrakeModel:
     contacts = scene.contacts
     world = plant.world_body()
     _quiet_half_space_warning()
+    rim_kind, floor_kind = [], []  # the geometries of each kind: (body side, ground side)
     if contacts.has_plane:  # rim vertices: spheres on the body over a half space
         for k, p in enumerate(contacts.rim_points):
             gid = plant.RegisterCollisionGeometry(
                 body, RigidTransform(p), Sphere(r), f"vertex{k}", on_body
             )
             contact_of[gid] = k
-        plant.RegisterCollisionGeometry(
+            rim_kind.append(gid)
+        ground = plant.RegisterCollisionGeometry(
             world, RigidTransform([0.0, 0.0, -r]), HalfSpace(), "ground", on_ground
         )
     if len(contacts.floor_points):  # floor points: spheres on the ground under a face
         hh = FACE_HALF_THICKNESS_FRACTION * b.radius
         side = 2.0 * b.radius
-        plant.RegisterCollisionGeometry(
+        face = plant.RegisterCollisionGeometry(
             body, RigidTransform([0.0, 0.0, r + hh]), Box(side, side, 2 * hh), "face", on_body
         )
+        floor_kind.append(face)
         for j, p in enumerate(contacts.floor_points):
             gid = plant.RegisterCollisionGeometry(
                 world, RigidTransform(p), Sphere(r), f"bump{j}", on_ground
             )
             contact_of[gid] = contacts.n_rim + j
+            floor_kind.append(gid)
+    if rim_kind and floor_kind:  # both kinds (bumpy): each body geometry meets its own
+        # partner only: the face not the half space, a vertex not a bump (SceneGraph
+        # filters pairs of geometries; the body's own pairs are filtered already)
+        manager = scene_graph.collision_filter_manager()
+        manager.Apply(
+            CollisionFilterDeclaration()
+            .ExcludeBetween(GeometrySet([face]), GeometrySet([ground]))
+            .ExcludeBetween(GeometrySet(rim_kind), GeometrySet(floor_kind[1:]))
+        )
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -scene.gravity])
     plant.Finalize()
     return DrakeModel(builder.Build(), plant, body, contact_of, settings)

@@ -1,7 +1,7 @@
 """The engine interface, typed: what an entry point of the group `harness.engines` is
 (docs/engines.md "Plugging in an engine").
 
-An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with four optional
+An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with five optional
 attributes; `engine_entry` sets them on a function, and `attribute` reads one with its
 default (harness.simulators reads them only through it).  A fixed-step adapter usually
 wraps its engine in an `engines.stepping.Stepper` and lets `engines.stepping.run_steps`
@@ -27,12 +27,15 @@ class Engine(Protocol):
     max_vertices      the largest polygon it takes (larger ones are refused before the
                       run, exit 2), or None for no limit
     reports_progress  True: it accepts `progress=callback(done, total)` and calls it
+    ground_kinds      the only ground kinds it takes (`flat`, `three_point`, `bumpy`;
+                      others are refused before the run, exit 2), or None for every ground
     """
 
     fixed_step: bool
     library: str | None
     max_vertices: int | None
     reports_progress: bool
+    ground_kinds: tuple[str, ...] | None
 
     def __call__(
         self, scene: Scene, *, dt: float | None = None, t_end: float | None = None
@@ -45,6 +48,7 @@ DEFAULTS: dict[str, Any] = {
     "library": None,
     "max_vertices": None,
     "reports_progress": False,
+    "ground_kinds": None,
 }
 
 
@@ -58,6 +62,7 @@ def engine_entry(
     library: str | None = None,
     max_vertices: int | None = None,
     reports_progress: bool = False,
+    ground_kinds: tuple[str, ...] | None = None,
 ) -> Callable[[Callable], Engine]:
     """Make a `simulate(scene, *, dt, t_end)` function an `Engine` with these attributes."""
 
@@ -66,6 +71,7 @@ def engine_entry(
         fn.library = library
         fn.max_vertices = max_vertices
         fn.reports_progress = reports_progress
+        fn.ground_kinds = ground_kinds
         return fn  # type: ignore[return-value]
 
     return mark

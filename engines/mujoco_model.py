@@ -44,6 +44,12 @@ CONTACT_SENSOR_DATA_FORCE = 2
 # bump deeper than the half-thickness would be pushed out through the top face; the run
 # loop (engines.stepping.FALL_THROUGH_DEPTH) ends the run before that.
 FACE_HALF_THICKNESS_FRACTION = 0.1
+# Bumpy ground: (contype, conaffinity) of the geoms of each contact kind.  The world's
+# geom (plane or bump) only receives (contype 0), the body's geom only reaches
+# (conaffinity 0), and the two kinds use different bits, so the only pairs MuJoCo
+# collides are vertex–plane (bit 1) and face–bump (bit 2).
+RIM_COLLISION = {"world": (0, 1), "body": (1, 0)}
+BUMP_COLLISION = {"world": (0, 2), "body": (2, 0)}
 
 # MuJoCo's own defaults, written out where the default profile uses them.
 MUJOCO_DEFAULT_TIMECONST = 0.02  # solref[0] default
@@ -234,19 +240,14 @@ def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec
     body.mass = scene.body.mass
     body.ipos = [0.0, 0.0, 0.0]
     body.inertia = list(scene.body.inertia_diag)
-    sphere, contacts = mujoco.mjtGeom.mjGEOM_SPHERE, scene.contacts
+    contacts = scene.contacts
+    # both kinds on one ground (bumpy): bit masks keep each body geom to its own partner
+    both = contacts.has_plane and len(contacts.floor_points) > 0
     if len(contacts.floor_points):  # floor points: spheres on the ground under a face
-        for j, p in enumerate(contacts.floor_points):
-            contact_geom(world, f"bump{j}", type=sphere, size=[r, 0, 0], pos=list(p))
-        hh = FACE_HALF_THICKNESS_FRACTION * a
-        contact_geom(
-            body, "face", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[a, hh, 0], pos=[0, 0, r + hh]
-        )
+        masks = BUMP_COLLISION if both else None
+        _add_bumps(world, body, contact_geom, contacts.floor_points, a, r, masks)
     if contacts.has_plane:  # rim vertices: spheres on the body over a plane
-        plane = mujoco.mjtGeom.mjGEOM_PLANE
-        contact_geom(world, "ground", type=plane, size=[0, 0, 1], pos=[0, 0, -r])
-        for k, p in enumerate(contacts.rim_points):
-            contact_geom(body, f"vertex{k}", type=sphere, size=[r, 0, 0], pos=list(p))
+        _add_rim(world, body, contact_geom, contacts.rim_points, r, RIM_COLLISION if both else None)
     for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
         spec.add_sensor(
             name=f"force{k}",
@@ -259,6 +260,34 @@ def build_spec(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjSpec
             intprm=[CONTACT_SENSOR_DATA_FORCE, 0, 1],
         )
     return spec
+
+
+def _add_rim(world, body, contact_geom, vertices, r: float, collision=None) -> None:
+    """The floor plane at z = −r and a sphere of radius r at each body-frame vertex."""
+    masks = _masks(collision)
+    plane, sphere = mujoco.mjtGeom.mjGEOM_PLANE, mujoco.mjtGeom.mjGEOM_SPHERE
+    contact_geom(world, "ground", type=plane, size=[0, 0, 1], pos=[0, 0, -r], **masks["world"])
+    for k, p in enumerate(vertices):
+        contact_geom(body, f"vertex{k}", type=sphere, size=[r, 0, 0], pos=list(p), **masks["body"])
+
+
+def _add_bumps(world, body, contact_geom, bumps, a: float, r: float, collision=None) -> None:
+    """A sphere of radius r centred at each world bump and the face: a cylinder of the
+    body's radius whose bottom lies at body height +r."""
+    masks = _masks(collision)
+    sphere = mujoco.mjtGeom.mjGEOM_SPHERE
+    for k, p in enumerate(bumps):
+        contact_geom(world, f"bump{k}", type=sphere, size=[r, 0, 0], pos=list(p), **masks["world"])
+    hh = FACE_HALF_THICKNESS_FRACTION * a
+    cylinder = mujoco.mjtGeom.mjGEOM_CYLINDER
+    contact_geom(body, "face", type=cylinder, size=[a, hh, 0], pos=[0, 0, r + hh], **masks["body"])
+
+
+def _masks(collision) -> dict[str, dict[str, int]]:
+    """MjsGeom attributes for (contype, conaffinity) pairs; none: MuJoCo's defaults."""
+    if collision is None:
+        return {"world": {}, "body": {}}
+    return {side: {"contype": ct, "conaffinity": ca} for side, (ct, ca) in collision.items()}
 
 
 def load_model(scene: Scene, dt: float, profile: str = "tuned") -> mujoco.MjModel:

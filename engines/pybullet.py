@@ -13,6 +13,14 @@ Geometry (docs/engines.md "Geometry that is exactly a point contact"):
   has the face normal e3; its distance is the reference's gap (x − b_k)·e3 minus
   r (1 − cos α) (measured: −1.002000e-4 for gap −1e-4 at α = 0.02, normal e3 to 4
   digits printed) and its lever is off by r sin α, both negligible for r ≪ a.
+- `bumpy` (both kinds): the plane with the vertex spheres, and spheres with their tops at
+  the bumps (x, y, h) under a thin face.  Bullet filters collisions per link, not per
+  shape, so the kinds are kept apart by geometry instead of masks: the face is a
+  cylinder of the polygon's inscribed radius a cos(π/n) (`FACE_INSCRIBED`), whose
+  bottom edge stays at or above the lowest vertex at every tilt, so it cannot reach the
+  plane (lowered by r) before a vertex sinks r into it; the vertex spheres reach a bump
+  only if the rim passes over it (bumps at b ≤ a/2 and a centre near the axis: never).
+  Bumps between a cos(π/n) and a from the centre are out of the face's reach.
 
 Inertia m(ρa)² diag(1, 1, 2) is written into the URDF and loaded with
 URDF_USE_INERTIA_FROM_FILE; the inertial frame is the link frame, so PyBullet's base
@@ -88,7 +96,7 @@ class Handles:
 
     client: int
     body: int
-    ground: tuple[int, ...]  # plane (flat) or the three bump bodies (three_point)
+    ground: tuple[int, ...]  # the plane (if the ground has one), then the bump bodies
     processing_threshold: float  # contact points farther than this carry no force
 
 
@@ -127,11 +135,16 @@ def body_urdf(scene: Scene, sphere_radius: float) -> str:
         ]
     if len(contacts.floor_points):  # floor points: touch the body's face
         h = FACE_THICKNESS * b.radius
-        side = 2.0 * b.radius  # a square face that covers the disk
+        if contacts.has_plane:  # both kinds: a face that never reaches the plane
+            rf = b.radius * math.cos(math.pi / b.n)
+            shape = f'<cylinder radius="{f(rf)}" length="{f(h)}"/>'
+        else:
+            side = 2.0 * b.radius  # a square face that covers the disk
+            shape = f'<box size="{f(side)} {f(side)} {f(h)}"/>'
         lines += [
             "    <collision>",
             f'      <origin xyz="0 0 {f(h / 2)}" rpy="0 0 0"/>',
-            f'      <geometry><box size="{f(side)} {f(side)} {f(h)}"/></geometry>',
+            f"      <geometry>{shape}</geometry>",
             "    </collision>",
         ]
     lines += ["  </link>", "</robot>", ""]
@@ -238,8 +251,6 @@ def build_world(scene: Scene, dt: float, profile: str = "tuned") -> Handles:
     The caller owns the client and must `pybullet.disconnect(handles.client)`."""
     if profile not in PROFILES:
         raise ValueError(f"unknown PyBullet profile {profile!r}; choose from {PROFILES}")
-    if not (scene.contacts.rim_only or not scene.contacts.has_plane):
-        raise ValueError("the PyBullet adapter builds a ground of one contact kind only")
     client = pb.connect(pb.DIRECT)
     try:
         return _build(client, scene, dt, profile)
@@ -268,31 +279,34 @@ def _build(client: int, scene: Scene, dt: float, profile: str) -> Handles:
             _write_urdf(scene, tmp),
             basePosition=[float(v) for v in x0],
             baseOrientation=[float(q0[1]), float(q0[2]), float(q0[3]), float(q0[0])],
-            flags=pb.URDF_USE_INERTIA_FROM_FILE,
+            # implicit cylinder: a true btCylinderShape for the bumpy ground's face (by default
+            # the importer makes a convex hull whose margin puts its bottom 1e-3 low)
+            flags=pb.URDF_USE_INERTIA_FROM_FILE | pb.URDF_USE_IMPLICIT_CYLINDER,
             useMaximalCoordinates=maximal,
             **cid,
         )
     v0, w0 = y0[L.VELOCITY], y0[L.ANGULAR_VELOCITY]
     pb.resetBaseVelocity(body, [float(v) for v in v0], [float(v) for v in w0], **cid)
 
-    if scene.contacts.rim_only:
+    ground: tuple[int, ...] = ()  # the plane first (if any), then the bumps in order
+    if scene.contacts.has_plane:
         plane = pb.createCollisionShape(pb.GEOM_PLANE, **cid)
-        ground = (
+        ground += (
             pb.createMultiBody(
                 0.0, plane, basePosition=[0.0, 0.0, -r], useMaximalCoordinates=maximal, **cid
             ),
         )
-    else:
+    if len(scene.contacts.floor_points):
         bump = pb.createCollisionShape(pb.GEOM_SPHERE, radius=r, **cid)
-        ground = tuple(
+        ground += tuple(
             pb.createMultiBody(
                 0.0,
                 bump,
-                basePosition=[float(x), float(y), -r],
+                basePosition=[float(x), float(y), float(z) - r],  # its top at the point
                 useMaximalCoordinates=maximal,
                 **cid,
             )
-            for x, y, _ in scene.contacts.floor_points
+            for x, y, z in scene.contacts.floor_points
         )
 
     e_body, e_ground = _restitutions(scene)
@@ -346,14 +360,16 @@ def contact_forces(h: Handles, scene: Scene) -> np.ndarray:
     forces = np.zeros(scene.n_contacts)
     ground_index = {gid: k for k, gid in enumerate(h.ground)}
     y = read_state(h)
+    contacts = scene.contacts
     for cp in pb.getContactPoints(bodyA=h.body, physicsClientId=h.client):
         if cp[9] > 0.0 and cp[8] <= h.processing_threshold:
-            if scene.contacts.rim_only:
+            g = ground_index[cp[2]]
+            if contacts.has_plane and g == 0:
                 k = _contact_index_flat(
                     np.array([cp[5]]), y[L.POSITION], y[L.QUATERNION], scene.body.n
                 )[0]
             else:
-                k = ground_index[cp[2]]
+                k = contacts.n_rim + g - int(contacts.has_plane)
             forces[k] += cp[9]
     return forces
 
@@ -460,8 +476,9 @@ def simulate_pybullet(
     if sample_every is None:
         time_unit = math.sqrt(a / scene.gravity) if scene.gravity > 0 else 1.0
         sample_every = max(1, min(n_steps, int(1e-3 * time_unit / dt)))
-    flat = scene.contacts.rim_only  # (else floor points: a ground of rim vertices alone or
-    n_contacts = scene.n_contacts  # of floor points alone, `build_world`)
+    flat = scene.contacts.rim_only
+    has_plane, n_rim = scene.contacts.has_plane, scene.contacts.n_rim
+    n_contacts = scene.n_contacts
 
     setup0 = time.perf_counter()
     h = build_world(scene, dt, profile)
@@ -478,7 +495,7 @@ def simulate_pybullet(
     J = np.array(stepper.rows_j)
     Y = _states(stepper.rows_raw)
     steps_run = int(J[-1])
-    impulses = _impulses(stepper.hits, J, Y, flat, scene.body.n, n_contacts, dt)
+    impulses = _impulses(stepper.hits, J, Y, has_plane, n_rim, n_contacts, dt)
     keep = _rows_to_keep(J, impulses, sample_every, steps_run)
     if status is Status.FAILED:  # keep the finite rows only
         keep &= np.all(np.isfinite(Y), axis=1)
@@ -515,27 +532,27 @@ def _states(rows: list[tuple]) -> np.ndarray:
     return raw[:, [0, 1, 2, 6, 3, 4, 5, 7, 8, 9, 10, 11, 12]]
 
 
-def _impulses(hits, J, Y, flat, n, n_contacts, dt) -> np.ndarray:
+def _impulses(hits, J, Y, has_plane, n_rim, n_contacts, dt) -> np.ndarray:
     """(rows, n_contacts) normal impulses: force × dt of every processed contact point,
     summed per scene contact, on the row of the step that applied it.
 
-    On flat ground a point is assigned to a vertex with the pose of the previous recorded
-    row: the collision pass that made the point ran at the start of its step."""
+    A point on the plane (ground body 0 when there is one) is assigned to a vertex with
+    the pose of the previous recorded row: the collision pass that made the point ran at
+    the start of its step.  A point on bump body j is floor contact n_rim + j."""
     out = np.zeros((len(J), n_contacts))
     if not hits:
         return out
     H = np.array(hits)
     steps = H[:, 0].astype(int)
     row = np.searchsorted(J, steps)  # a step with contact points is always recorded
-    if flat:
-        prev = np.maximum(row - 1, 0)
-        k = np.empty(len(H), dtype=int)
-        for r in np.unique(prev):
-            sel = prev == r
-            y = Y[r]
-            k[sel] = _contact_index_flat(H[sel, 2:5], y[L.POSITION], y[L.QUATERNION], n)
-    else:
-        k = H[:, 1].astype(int)
+    ground = H[:, 1].astype(int)
+    k = n_rim + ground - int(has_plane)
+    on_plane = (ground == 0) if has_plane else np.zeros(len(H), dtype=bool)
+    prev = np.maximum(row - 1, 0)
+    for r in np.unique(prev[on_plane]):
+        sel = on_plane & (prev == r)
+        y = Y[r]
+        k[sel] = _contact_index_flat(H[sel, 2:5], y[L.POSITION], y[L.QUATERNION], n_rim)
     np.add.at(out, (row, k), H[:, 5] * dt)
     return out
 

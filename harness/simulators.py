@@ -189,7 +189,8 @@ def check_run(
 ) -> float | None:
     """Everything a run needs, checked before it starts (SceneError, exit status 2):
     t_end in the scene's range (and the scene's speed group with that t_end), the
-    engine's vertex limit (`max_vertices` attribute of its entry point), and for
+    engine's vertex limit and grounds (`max_vertices`, `ground_kinds` attributes of its
+    entry point), and for
     fixed-step engines 0 < dt <= t_end and t_end / dt <= max_steps
     (DEFAULT_MAX_STEPS).  Returns the timestep the engine gets (None: not fixed-step)."""
     simulate = load_engine(engine)
@@ -205,6 +206,11 @@ def check_run(
     horizon = run_horizon(scene, t_end)
     if t_end is not None:
         scene = scene.with_run(t_end=horizon)
+    grounds = attribute(simulate, "ground_kinds")
+    if grounds is not None and scene.ground.kind not in grounds:
+        raise SceneError(
+            f"engine {engine!r} takes {' and '.join(grounds)} grounds, not {scene.ground.kind}"
+        )
     limit = attribute(simulate, "max_vertices")
     if limit is not None and scene.body.n > limit:
         raise SceneError(

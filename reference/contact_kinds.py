@@ -109,6 +109,19 @@ def ground_contacts(n_rim: int, radius: float, n_floor: int, floor_radius: float
     return GroundContacts(pts, n_rim)
 
 
+@functools.lru_cache(maxsize=64)
+def listed_contacts(
+    n_rim: int, radius: float, floor_points: tuple[tuple[float, float, float], ...]
+) -> GroundContacts:
+    """GroundContacts of n_rim rim vertices a(cos 2πk/n_rim, sin 2πk/n_rim, 0) then the
+    floor points given (world (x, y, z), e.g. bumps above the plane: the bumpy ground)."""
+    pts = np.concatenate(
+        [_regular_points(n_rim, radius), np.asarray(floor_points, dtype=float).reshape(-1, 3)]
+    )
+    pts.setflags(write=False)
+    return GroundContacts(pts, n_rim)
+
+
 def _regular_points(k: int, r: float) -> np.ndarray:
     """(k, 3): r (cos 2πi/k, sin 2πi/k, 0)."""
     ang = 2.0 * np.pi * np.arange(k) / k

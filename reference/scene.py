@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from .contact_kinds import GroundContacts, ground_contacts
+from .contact_kinds import GroundContacts, ground_contacts, listed_contacts
 from .core.layout import QUATERNION
 from .geometry import initial_state, scene_contact_kinematics
 from .quaternion import body_axis
@@ -94,17 +94,32 @@ class Body:
 class Ground:
     """The scene file's [ground]: `flat`, the plane z = 0 that the body's rim vertices
     touch; `three_point`, floor points (bumps) at (b cos 2πk/3, b sin 2πk/3, 0) that
-    touch the body's face.  `contacts` turns it into the list of contacts of kinds
-    (reference.contact_kinds) that everything else reads."""
+    touch the body's face; `bumpy` (issue 32), both: the plane under the rim and bumps
+    above it under the face, `bumps` (x, y, height) or three at (b cos 2πk/3,
+    b sin 2πk/3, bump_height).  Lengths in the scene's units, like the body's radius.
+    `contacts` turns it into the list of contacts of kinds (reference.contact_kinds)
+    that everything else reads."""
 
     kind: str = "flat"
     bump_radius: float = 0.5
+    bump_height: float = 0.0
+    bumps: tuple[tuple[float, float, float], ...] | None = None
+
+    def bump_table(self) -> tuple[tuple[float, float, float], ...]:
+        """(x, y, height) of every bump of a bumpy ground (module docstring)."""
+        if self.bumps is not None:
+            return self.bumps
+        b, ang = self.bump_radius, [2.0 * math.pi * k / 3 for k in range(3)]
+        return tuple((b * math.cos(t), b * math.sin(t), self.bump_height) for t in ang)
 
     def contacts(self, body: Body) -> GroundContacts:
         """The ground's contacts for this body: `flat`, its n rim vertices on the plane;
-        `three_point`, three floor points on its face."""
+        `three_point`, three floor points on its face; `bumpy`, the n rim vertices then
+        the bumps."""
         if self.kind == "three_point":
             return ground_contacts(0, body.radius, 3, self.bump_radius)
+        if self.kind == "bumpy":
+            return listed_contacts(body.n, body.radius, self.bump_table())
         return ground_contacts(body.n, body.radius, 0, self.bump_radius)
 
     @property
@@ -220,7 +235,10 @@ _TOP_KEYS = {
     "body", "ground", "initial", "run",
 }  # fmt: skip
 _BODY_KEYS = {"n", "radius", "mass", "gyration"}
-_GROUND_KEYS = {"kind", "bump_radius"}
+_GROUND_KEYS = {"kind", "bump_radius", "bump_height", "bumps"}
+GROUND_KINDS = ("flat", "three_point", "bumpy")
+# Most bumps a bumpy ground may list (each is a contact the search examines one by one).
+MAX_BUMPS = 64
 _INITIAL_LINEAR = {"q", "p", "scale"}
 _INITIAL_FULL = {"position", "rotation_vector", "velocity", "angular_velocity"}
 _RUN_KEYS = {"t_end", "max_impacts"}
@@ -361,17 +379,56 @@ def _parse_body(b: dict) -> Body:
 def _parse_ground(gr: dict, body: Body) -> Ground:
     _check_keys("[ground]", gr, _GROUND_KEYS)
     kind = gr.get("kind", "flat")
-    if kind not in ("flat", "three_point"):
-        raise SceneError(f"ground.kind must be 'flat' or 'three_point', got {kind!r}")
+    if kind not in GROUND_KINDS:
+        raise SceneError(f"ground.kind must be 'flat', 'three_point' or 'bumpy', got {kind!r}")
+    if kind != "bumpy" and ("bump_height" in gr or "bumps" in gr):
+        raise SceneError("ground.bump_height and ground.bumps belong to kind = 'bumpy'")
+    if kind == "bumpy" and "bumps" in gr:
+        if "bump_radius" in gr or "bump_height" in gr:
+            raise SceneError(
+                "[ground] gives either bumps = [[x, y, height], ...] or bump_radius and "
+                "bump_height, not both"
+            )
+        return Ground(kind=kind, bumps=_parse_bumps(gr["bumps"], body.radius))
     bump = _number("ground.bump_radius", gr.get("bump_radius", 0.5 * body.radius))
-    if kind == "three_point" and not MIN_BUMP_RADIUS <= bump / body.radius < 1.0:
+    if kind != "flat" and not MIN_BUMP_RADIUS <= bump / body.radius < 1.0:
         raise SceneError(
             f"ground.bump_radius must be in [{MIN_BUMP_RADIUS:g}, 1) x body.radius "
             f"({body.radius:g}), got {bump:g}"
         )
     if kind == "flat" and not bump > 0:
         raise SceneError(f"ground.bump_radius must be > 0, got {bump!r}")
+    if kind == "bumpy":
+        height = _number("ground.bump_height", gr.get("bump_height", 0.0))
+        _check_bump_height("ground.bump_height", height, body.radius)
+        return Ground(kind=kind, bump_radius=bump, bump_height=height)
     return Ground(kind=kind, bump_radius=bump)
+
+
+def _parse_bumps(value: Any, radius: float) -> tuple[tuple[float, float, float], ...]:
+    """ground.bumps: 1 … MAX_BUMPS triples (x, y, height), each under the disk lying
+    centred (less than a radius from the axis) and below a radius high."""
+    if not isinstance(value, list) or not 1 <= len(value) <= MAX_BUMPS:
+        raise SceneError(f"ground.bumps must be a list of 1 to {MAX_BUMPS} [x, y, height]")
+    out = []
+    for j, item in enumerate(value):
+        if not isinstance(item, list) or len(item) != 3:
+            raise SceneError(f"ground.bumps[{j}] must be [x, y, height]")
+        x, y, h = (_number(f"ground.bumps[{j}]", v) for v in item)
+        if not math.hypot(x, y) < radius:
+            raise SceneError(
+                f"ground.bumps[{j}] lies {math.hypot(x, y):g} from the axis: a bump must lie "
+                f"under the disk, less than body.radius ({radius:g})"
+            )
+        _check_bump_height(f"ground.bumps[{j}] height", h, radius)
+        out.append((x, y, h))
+    return tuple(out)
+
+
+def _check_bump_height(name: str, h: float, radius: float) -> None:
+    """A bump is an imperfection of the floor: 0 ≤ height < the body's radius."""
+    if not 0.0 <= h < radius:
+        raise SceneError(f"{name} must be in [0, body.radius) = [0, {radius:g}), got {h:g}")
 
 
 def _parse_initial(ini: dict) -> InitialState:

@@ -5,9 +5,12 @@
   grazing state and running the closed-form flight backwards by T_GRAZE.
 - near-simultaneous: a square falling without rotation, tilted so that vertex 1 is
   DT_APART·|v| higher than vertex 0: the two hit DT_APART ≈ 1e-12 s apart.
+- bumpy-transition, bumpy-rolling: the transition study's rolling polygon over three
+  bumps (harness.transition.scene, in the paper's units), its rolling rate computed from
+  the tilt; the first followed to the end, the second a short one engines run in seconds.
 
 Run: python scripts/make_scenes.py
-(rewrites reference/scenes/{grazing-contact,near-simultaneous}.toml)
+(rewrites reference/scenes/{grazing-contact,near-simultaneous,bumpy-*}.toml)
 """
 
 from __future__ import annotations
@@ -131,7 +134,56 @@ def near_simultaneous() -> str:
     )
 
 
+def bumpy(name: str, description: str, **study) -> str:
+    """A scene of the transition study as TOML (linear coordinates of its rolling start)."""
+    from harness.transition.scene import transition_scene
+
+    s = transition_scene(name=name, **study)
+    g, b, i = s.ground, s.body, s.initial
+    f = lambda v: "[" + ", ".join(repr(float(x)) for x in v) + "]"  # noqa: E731
+    return f'''name = "{name}"
+description = "{description}"
+gravity = {s.gravity!r}
+restitution = {s.restitution!r}
+
+[body]
+n = {b.n}
+radius = {b.radius!r}
+mass = {b.mass!r}
+gyration = {b.gyration!r}
+
+[ground]
+kind = "bumpy"
+bump_radius = {g.bump_radius!r}
+bump_height = {g.bump_height!r}
+
+[initial]
+q = {f(i.q)}
+p = {f(i.p)}
+
+[run]
+t_end = {s.run.t_end!r}
+max_impacts = {s.run.max_impacts}
+'''
+
+
+BUMPY_SCENES = {
+    "bumpy-transition": (
+        "100-gon (rho 0.5, gamma 0.5) rolling at tilt 0.02 over 3 bumps of 1e-4 m, "
+        "d = 0.1 m, g = 9.81: rim, mixed, bumps to the end",
+        dict(delta=1e-4, tilt=0.02, n=100, t_end=1.0, max_impacts=1_000_000),
+    ),
+    "bumpy-rolling": (
+        "20-gon (rho 0.5, gamma 0) rolling at tilt 0.01 over 3 bumps of 1e-4 m, "
+        "d = 0.1 m: rim impacts, then the first bump impacts (short: for engines)",
+        dict(delta=1e-4, tilt=0.01, n=20, restitution=0.0, t_end=0.04, max_impacts=100_000),
+    ),
+}
+
+
 if __name__ == "__main__":
     (OUT / "grazing-contact.toml").write_text(grazing())
     (OUT / "near-simultaneous.toml").write_text(near_simultaneous())
-    print("wrote", OUT / "grazing-contact.toml", OUT / "near-simultaneous.toml")
+    for name, (description, study) in BUMPY_SCENES.items():
+        (OUT / f"{name}.toml").write_text(bumpy(name, description, **study))
+    print("wrote", OUT / "grazing-contact.toml", OUT / "near-simultaneous.toml", *BUMPY_SCENES)

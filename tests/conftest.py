@@ -17,6 +17,7 @@ def make_scene(
     p=(0.05, 0.02, -0.1),
     ground="flat",
     bump=0.5,
+    bump_height=0.0,
     t_end=3.0,
     max_impacts=100_000,
     state=None,
@@ -33,7 +34,7 @@ def make_scene(
     return Scene(
         name=name,
         body=Body(n=n, gyration=rho),
-        ground=Ground(kind=ground, bump_radius=bump),
+        ground=Ground(kind=ground, bump_radius=bump, bump_height=bump_height),
         initial=initial,
         restitution=gamma,
         gravity=1.0,

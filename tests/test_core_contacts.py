@@ -1,7 +1,7 @@
 """Contact primitives of the compiled core (reference.core.contacts, inertia, held)
 against the oracle's numpy expressions (tests/oracle): gap jets, the contact system
 A = J M⁻¹ Jᵀ and b, the complementarity problem and the projections, on random states
-over both grounds."""
+over every ground (bumpy: both kinds at once)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,9 @@ from tests.oracle.contact import contact_system as oracle_system
 from tests.oracle.contact import project_positions, project_velocities, solve_contact_lcp
 from tests.oracle.events import gap_jet
 
-GROUNDS = [("flat", 5), ("flat", 100), ("three_point", 3)]
+GROUNDS = [("flat", 5), ("flat", 100), ("three_point", 3), ("bumpy", 12)]
+# bumpy: rim vertices and bumps 0.01 a high, both kinds in one contact list
+HEIGHT = {"bumpy": {"bump_height": 0.01}}
 
 
 def _random_state(rng, tilt=0.2):
@@ -40,7 +42,7 @@ def _random_state(rng, tilt=0.2):
 @pytest.mark.parametrize("ground,n", GROUNDS)
 def test_gap_jets_equal_the_oracles_array_expressions(ground, n):
     rng = np.random.default_rng(n)
-    scene = make_scene(n=n, ground=ground, rho=0.43)
+    scene = make_scene(n=n, ground=ground, rho=0.43, **HEIGHT.get(ground, {}))
     model, pts = core_model(scene)
     oracle = BodyModel.from_scene(scene)
     for _ in range(20):
@@ -58,7 +60,7 @@ def test_gap_jets_equal_the_oracles_array_expressions(ground, n):
 @pytest.mark.parametrize("ground,n", GROUNDS)
 def test_contact_system_equals_the_oracles(ground, n):
     rng = np.random.default_rng(7 + n)
-    scene = make_scene(n=n, ground=ground, rho=0.43)
+    scene = make_scene(n=n, ground=ground, rho=0.43, **HEIGHT.get(ground, {}))
     model, pts = core_model(scene)
     oracle = BodyModel.from_scene(scene)
     scratch = new_work()
@@ -99,7 +101,7 @@ def test_projection_equals_the_oracles(ground, n):
     oracle's Gauss–Newton passes and normal impulses, and the held gaps and normal
     velocities at roundoff."""
     rng = np.random.default_rng(11 + n)
-    scene = make_scene(n=n, ground=ground, rho=0.43)
+    scene = make_scene(n=n, ground=ground, rho=0.43, **HEIGHT.get(ground, {}))
     model, pts = core_model(scene)
     oracle = BodyModel.from_scene(scene)
     scratch = new_work()

@@ -484,3 +484,20 @@ def test_write_time_and_size_of_a_long_three_simulator_recording(tmp_path):
     print(f"\n3 x 100000 samples: wrote {path.stat().st_size / 1e6:.1f} MB in {seconds:.2f} s")
     _, values = scalars(path, "/pybullet_dt1e-04/energy/log10_excess")
     assert len(values) == 100_000
+
+
+def test_bumpy_recording_draws_the_bumps_and_sets_bump_impacts_apart(tmp_path, capsys):
+    """compare on bumpy-rolling with MuJoCo: the bumps are drawn, and each raster's bump
+    impacts (contacts n … of the 20-gon) are diamonds in their own series, apart from
+    the rim's."""
+    out = tmp_path / "bumpy.rrd"
+    argv = ["compare", "bumpy-rolling", "--engine", "mujoco", "--dt", "1e-4"]
+    assert main([*argv, "--record", str(out), "--json"]) == 0
+    capsys.readouterr()
+    found = entities(out)
+    assert {"/reference/scene/ground/bumps", "/impacts/reference/bump"} <= found
+    diamond = rr.components.MarkerShape.Diamond.value
+    assert static_value(out, "/impacts/reference/bump", "SeriesPoints:markers") == [diamond]
+    _, rim = scalars(out, "/impacts/reference")
+    _, bump = scalars(out, "/impacts/reference/bump")
+    assert len(bump) >= 1 and np.all(bump >= 20) and np.all(rim < 20)

@@ -49,7 +49,8 @@ _DELETE = object()
         (("gravity",), math.nan, "gravity must be finite"),
         (("initial", "q"), [0.0, math.nan, 0.4], "initial.q[1] must be finite"),
         (("body", "colour"), "red", "unknown key(s) colour"),
-        (("ground", "kind"), "bumpy", "ground.kind must be"),
+        (("ground", "kind"), "hilly", "ground.kind must be"),
+        (("ground", "bump_height"), 0.1, "belong to kind = 'bumpy'"),
         (("initial", "q"), [0.0, 0.5, 0.1], "starts below the ground"),
         (("initial", "p"), _DELETE, "needs both q and p"),
     ],
@@ -59,6 +60,40 @@ def test_bad_scene_is_rejected_with_a_clear_message(path, value, fragment):
         scene_from_dict(_with(path, value))
     assert fragment in str(info.value)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "ground,fragment",
+    [
+        ({"bumps": [[0.1, 0.0, 0.01]], "bump_height": 0.01}, "not both"),
+        ({"bumps": []}, "ground.bumps must be a list of 1 to 64"),
+        ({"bumps": [[0.1, 0.0]]}, "ground.bumps[0] must be [x, y, height]"),
+        ({"bumps": [[1.0, 0.2, 0.01]]}, "must lie under the disk"),
+        ({"bumps": [[0.1, 0.0, -0.01]]}, "ground.bumps[0] height must be in [0, body.radius)"),
+        ({"bump_height": 1.0}, "ground.bump_height must be in [0, body.radius)"),
+        ({"bump_radius": 1.2}, "ground.bump_radius must be in"),
+    ],
+)
+def test_bad_bumpy_ground_is_rejected_with_a_clear_message(ground, fragment):
+    with pytest.raises(SceneError) as info:
+        scene_from_dict(_with(("ground",), {"kind": "bumpy", **ground}))
+    assert fragment in str(info.value)
+
+
+def test_bumpy_ground_lists_the_rim_vertices_then_the_bumps():
+    """bump_radius and bump_height are lengths, like three_point's bump_radius."""
+    doc = _with(("body", "radius"), 2.0)
+    doc["ground"] = {"kind": "bumpy", "bump_radius": 1.0, "bump_height": 0.004}
+    doc["initial"] = {"q": [0.0003, -0.0002, 0.4], "p": [0.03, -0.02, -1.0]}
+    contacts = scene_from_dict(doc).contacts
+    assert contacts.n_rim == 3 and contacts.n == 6
+    assert math.hypot(*contacts.floor_points[1][:2]) == pytest.approx(1.0, rel=1e-15)
+    assert list(contacts.floor_points[:, 2]) == [0.004] * 3
+    doc["ground"] = {"kind": "bumpy", "bumps": [[0.1, 0.2, 0.003], [-0.3, 0.0, 0.0]]}
+    assert scene_from_dict(doc).contacts.floor_points.tolist() == [
+        [0.1, 0.2, 0.003],
+        [-0.3, 0.0, 0.0],
+    ]
 
 
 def test_missing_and_malformed_files_are_scene_errors(tmp_path):

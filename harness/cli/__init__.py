@@ -39,6 +39,7 @@ from . import (
     simulate,
     stress,
     sweep,
+    transition,
 )
 from .common import BadInput, Parser, add_verbose, configure_logging
 
@@ -56,6 +57,7 @@ COMMANDS = (
     sweep,
     figures,
     report,
+    transition,
 )
 
 

@@ -105,8 +105,21 @@ def run(args) -> int:
         note("harness: interrupted; the summary covers the part computed, no file written")
     else:
         write_outputs(args, traj, scene)
-    emit(traj.summary(with_impacts=True), args.json, format_simulate(traj))
+    emit(summary_with_kinds(traj, scene), args.json, format_simulate(traj))
     return INTERRUPTED if interrupted else 0
+
+
+def summary_with_kinds(traj, scene) -> dict:
+    """The run's summary; on a bumpy ground each impact row also says which kind of
+    contact took it (`kind`: rim or bump)."""
+    from reference.bumpy import contact_kind_names, is_bumpy
+
+    doc = traj.summary(with_impacts=True)
+    if is_bumpy(scene):
+        names = contact_kind_names(scene)
+        for row in doc["impacts"]:
+            row["kind"] = names[row["contact"]]
+    return doc
 
 
 def write_outputs(args, traj, scene) -> None:

@@ -156,7 +156,7 @@ def _write(
         for run in runs:
             log_scene(rec, run, scene, schedule, tol)
             log_rows(rec, run)
-        log_raster(rec, runs)
+        log_raster(rec, runs, scene.contacts)
         if horizons is not None:
             from .horizon import log_horizon_bands
 

@@ -28,7 +28,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from .plot2d import Axes
-from .raster import BEHIND, RASTER
+from .raster import BEHIND, RASTER, bump_path
 from .rows import SIM_TIME
 from .runs import RunView
 from .singularity import ALPHA, ENERGY
@@ -131,11 +131,12 @@ def _raster_row(
     for run in runs:
         contents = [
             f"{RASTER}/{run.name}",
+            bump_path(f"{RASTER}/{run.name}"),
             f"{RASTER}/{run.name}/first_mismatch",
             f"{RASTER}/{run.name}/horizon_band",
         ]
         if not run.is_reference:
-            contents.append(f"{BEHIND}/{ref.name}")
+            contents += [f"{BEHIND}/{ref.name}", bump_path(f"{BEHIND}/{ref.name}")]
         views.append(
             rrb.TimeSeriesView(
                 origin="/",

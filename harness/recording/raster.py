@@ -3,9 +3,12 @@ times, y = the contact's index (vertex k on flat ground, bump k on three bumps),
 marker's size growing with the impulse; in an engine's raster the reference's impacts
 are drawn behind, small and faint, so a missed, extra or shifted impact shows where
 the two differ; the first impact that disagrees with the reference is marked by a red
-cross.
+cross.  On a ground with both contact kinds (`bumpy`: the rim vertices, then the bumps
+above them) the bump impacts are diamonds in their own series, so the kind that took
+each impulse shows at a glance.
 
     /impacts/<sim>                  SeriesPoints, y = contact index
+    /impacts/<sim>/bump             the bump impacts (diamonds), on a bumpy ground
     /impacts/behind/<reference>     the reference's impacts again, faint (engines' views)
     /impacts/<sim>/first_mismatch   one red cross at the first mismatch (if any)
     /<sim>/impacts/log              one TextLog line per impact (contact, time, impulse,
@@ -16,6 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 import rerun as rr
+
+from reference.contact_kinds import GroundContacts
 
 from .rows import time_column
 from .runs import RunView, mismatch_marker
@@ -49,43 +54,59 @@ def largest_impulse(runs: list[RunView]) -> float:
     )
 
 
-def log_raster(rec: rr.RecordingStream, runs: list[RunView]) -> None:
+def log_raster(rec: rr.RecordingStream, runs: list[RunView], contacts: GroundContacts) -> None:
     """Every simulator's impacts, the reference's faint copy and the mismatch markers
     (module docstring)."""
     biggest = largest_impulse(runs)
     ref = runs[0]
-    _log_impacts(rec, f"{BEHIND}/{ref.name}", ref, biggest, BEHIND_ALPHA, BEHIND_SCALE)
+    behind = f"{BEHIND}/{ref.name}"
+    _log_impacts(rec, behind, ref, contacts, biggest, BEHIND_ALPHA, BEHIND_SCALE)
     for run in runs:
-        _log_impacts(rec, f"{RASTER}/{run.name}", run, biggest)
+        _log_impacts(rec, f"{RASTER}/{run.name}", run, contacts, biggest)
         _log_mismatch(rec, run)
         _log_impact_text(rec, run)
+
+
+def bump_path(path: str) -> str:
+    """Where a raster's bump impacts go on a ground with both kinds."""
+    return f"{path}/bump"
 
 
 def _log_impacts(
     rec: rr.RecordingStream,
     path: str,
     run: RunView,
+    contacts: GroundContacts,
     biggest: float,
     alpha: int = 255,
     scale: float = 1.0,
 ) -> None:
-    rec.log(
-        path,
-        rr.SeriesPoints(colors=[(*run.color, alpha)], names=[run.label], markers=["circle"]),
-        static=True,
-    )
+    """The run's impacts at `path`; on a ground with both kinds its bump impacts apart,
+    as diamonds at bump_path(path)."""
     traj = run.trajectory
-    if not traj.impacts:
-        return
-    sizes = scale * marker_sizes(traj.impact_column("impulse"), biggest)
-    rec.send_columns(
-        path,
-        [time_column(traj.impact_times())],
-        [
-            *rr.Scalars.columns(scalars=traj.impact_contacts().astype(float)),
-            *rr.SeriesPoints.columns(marker_sizes=sizes),
-        ],
-    )
+    k = traj.impact_contacts().astype(int) if traj.impacts else np.zeros(0, dtype=int)
+    both = 0 < contacts.n_rim < contacts.n
+    on_bump = k >= contacts.n_rim if both else np.zeros(len(k), dtype=bool)
+    series = [(path, ~on_bump, "circle", run.label)]
+    if both:
+        series.append((bump_path(path), on_bump, "diamond", f"{run.label} bump impacts"))
+    sizes = scale * marker_sizes(traj.impact_column("impulse"), biggest) if len(k) else k
+    for where, keep, marker, name in series:
+        rec.log(
+            where,
+            rr.SeriesPoints(colors=[(*run.color, alpha)], names=[name], markers=[marker]),
+            static=True,
+        )
+        if not keep.any():
+            continue
+        rec.send_columns(
+            where,
+            [time_column(traj.impact_times()[keep])],
+            [
+                *rr.Scalars.columns(scalars=k[keep].astype(float)),
+                *rr.SeriesPoints.columns(marker_sizes=sizes[keep]),
+            ],
+        )
 
 
 def _log_mismatch(rec: rr.RecordingStream, run: RunView) -> None:
@@ -103,13 +124,15 @@ def _log_mismatch(rec: rr.RecordingStream, run: RunView) -> None:
     rec.send_columns(path, [time_column([t])], rr.Scalars.columns(scalars=[float(contact)]))
 
 
-def _log_impact_text(rec: rr.RecordingStream, run: RunView) -> None:
-    """One line per impact in the run's impact log."""
+def _log_impact_text(rec: rr.RecordingStream, run: RunView, contacts: GroundContacts) -> None:
+    """One line per impact in the run's impact log, naming the contact and its kind
+    ('v2' rim vertex 2, 'b1' bump 1)."""
     imps = run.trajectory.impacts
     if not imps:
         return
     lines = [
-        f"{run.label} impact {i}: contact {e.contact} at t = {float(e.t)!r}"
+        f"{run.label} impact {i}: contact {e.contact} ({contacts.label(e.contact)}) "
+        f"at t = {float(e.t)!r}"
         + (f" (lo {float(e.t_lo):+.3g})" if e.t_lo else "")
         + f", impulse {e.impulse:.6g}, v_n {e.v_normal_pre:.6g} → {e.v_normal_post:.6g}"
         for i, e in enumerate(imps)

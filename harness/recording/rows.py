@@ -219,7 +219,7 @@ def _log_static_scene(
     )
     if len(scene.contacts.floor_points):
         r = 0.04 * a
-        bumps = bump_positions(scene) - np.array([0.0, 0.0, r])  # tips at z = 0
+        bumps = bump_positions(scene) - np.array([0.0, 0.0, r])  # tips at the floor points
         rec.log(
             f"{root}/ground/bumps",
             rr.Points3D(bumps, radii=[r], colors=[(200, 170, 60)]),

@@ -104,6 +104,7 @@ def stress_cases() -> list[StressCase]:
     n1000 = n1000.with_run(t_end=1.0)
     rolling = resolve_scene("polygon25-rolling").with_run(t_end=1.0)
     three = resolve_scene("three-point-disk").with_run(t_end=1.0)
+    bumpy = resolve_scene("bumpy-rolling")
     cases += [
         StressCase("grazing", grazing.description, grazing),
         StressCase("near-simultaneous", near.description, near),
@@ -127,6 +128,7 @@ def stress_cases() -> list[StressCase]:
         StressCase("n1000", "pentagon-bounce's state with n = 1000 (t_end 1)", n1000),
         StressCase("rolling-gamma0", rolling.description + " (t_end 1)", rolling),
         StressCase("three-point", three.description + " (t_end 1)", three),
+        StressCase("bumpy", bumpy.description, bumpy),
     ]
     return cases
 

@@ -10,7 +10,11 @@ Contacts (docs/architecture.md, "The model"):
   face (plane through the centre of mass with normal e3 = R ẑ) touches it;
   gap = (x − b_k)·e3; normal e3; lever r_k = in-plane projection of b_k − x.
 
-For both, d(gap)/dt = n·(v + ω × r) and the normal acceleration is J_k [v̇; ω̇] + bias_k
+- `bumpy` (issue 32): both at once, the n vertices on the plane z = 0 first (contacts
+  0 … n−1, as on `flat`), then the bumps under the face (contacts n …, as on
+  `three_point`), bump j at (x_j, y_j, h_j) above the plane.
+
+For all, d(gap)/dt = n·(v + ω × r) and the normal acceleration is J_k [v̇; ω̇] + bias_k
 with J_k = [nᵀ, (r_k × n)ᵀ].
 """
 
@@ -23,7 +27,7 @@ import numpy as np
 
 from reference.geometry import contact_points
 from reference.geometry import initial_state as geometry_initial_state
-from reference.scene import Scene
+from reference.scene import Ground, Scene
 
 from . import quaternion as qt
 
@@ -39,6 +43,17 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
+def bumpy_points(scene: Scene) -> np.ndarray:
+    """(m, 3) world bump positions of a bumpy ground, from the scene's numbers (lengths):
+    `bumps` (x, y, height) when given, else three at bump_radius and bump_height."""
+    g = scene.ground
+    if g.bumps is not None:
+        return np.array(g.bumps, dtype=float).reshape(-1, 3)
+    ang = 2.0 * np.pi * np.arange(3) / 3
+    b = g.bump_radius
+    return np.stack([b * np.cos(ang), b * np.sin(ang), np.full(3, g.bump_height)], axis=1)
+
+
 @dataclass(frozen=True)
 class BodyModel:
     mass: float
@@ -46,26 +61,49 @@ class BodyModel:
     i3: float  # inertia about the symmetry axis, 2 m (ρ a)²
     radius: float
     gravity: float
-    flat: bool
-    points: np.ndarray  # body-frame vertices (flat) or world bump positions (three_point)
+    vertices: np.ndarray  # body-frame rim vertices on the plane, contacts 0 … n−1; (0, 3): none
+    bumps: np.ndarray  # world bump positions under the face, the contacts after; (0, 3): none
+    rest_height: float = 0.0  # height of the centre lying flat on the bumps
 
     @classmethod
     def from_scene(cls, scene: Scene) -> BodyModel:
         i1, _, i3 = scene.body.inertia_diag
-        pts = contact_points(scene.body, scene.ground)
+        none = np.zeros((0, 3))
+        kind = scene.ground.kind
+        if kind == "bumpy":
+            vertices = contact_points(scene.body, Ground(kind="flat"))
+            bumps = bumpy_points(scene)
+        elif kind == "flat":
+            vertices, bumps = contact_points(scene.body, scene.ground), none
+        else:
+            vertices, bumps = none, contact_points(scene.body, scene.ground)
+        heights = np.sort(bumps[:, 2])[::-1][:3]
         return cls(
             mass=scene.body.mass,
             i1=i1,
             i3=i3,
             radius=scene.body.radius,
             gravity=scene.gravity,
-            flat=scene.ground.kind == "flat",
-            points=pts,
+            vertices=vertices,
+            bumps=bumps,
+            rest_height=float(heights.mean()) if len(heights) else 0.0,
         )
 
     @property
+    def flat(self) -> bool:
+        """Only rim vertices on the plane (the `flat` ground)."""
+        return len(self.bumps) == 0
+
+    @property
+    def n_rim(self) -> int:
+        return len(self.vertices)
+
+    @property
     def n_contacts(self) -> int:
-        return len(self.points)
+        return len(self.vertices) + len(self.bumps)
+
+    def is_bump(self, k: int) -> bool:
+        return k >= self.n_rim
 
     # ------------------------------------------------------------------ inertia
     def inertia_world(self, q: np.ndarray) -> np.ndarray:
@@ -84,34 +122,55 @@ class BodyModel:
 
         Returns (gap (k,), normal (k,3), lever (k,3), vn (k,), noise (k,)) where `noise`
         is the roundoff level of the gap (a few ulps of the terms that form it)."""
+        idx = np.arange(self.n_contacts) if idx is None else np.asarray(idx, dtype=int)
+        rim = idx < self.n_rim
+        if rim.all():
+            return self._rim_contacts(y, self.vertices[idx])
+        if not rim.any():
+            return self._bump_contacts(y, self.bumps[idx - self.n_rim])
+        parts = (
+            self._rim_contacts(y, self.vertices[idx[rim]]),
+            self._bump_contacts(y, self.bumps[idx[~rim] - self.n_rim]),
+        )
+        out = []
+        for a, b in zip(*parts, strict=True):
+            full = np.empty((len(idx), *a.shape[1:]))
+            full[rim], full[~rim] = a, b
+            out.append(full)
+        return tuple(out)
+
+    def _rim_contacts(self, y: np.ndarray, pts: np.ndarray):
+        """Vertices (body frame) on the plane z = 0: gap z + (R p)_z, normal e_z."""
         x, q, v, w = y[X], y[Q], y[V], y[W]
-        pts = self.points if idx is None else self.points[idx]
-        if self.flat:
-            R = qt.to_matrix(q)
-            # z-row computed from the small quaternion terms directly
-            wq, xq, yq, zq = q
-            lever = pts @ R.T
-            rz = pts[:, 0] * (2 * (xq * zq - wq * yq)) + pts[:, 1] * (2 * (yq * zq + wq * xq))
-            lever[:, 2] = rz
-            gap = x[2] + rz
-            normal = np.zeros_like(lever)
-            normal[:, 2] = 1.0
-            vn = v[2] + (w[0] * lever[:, 1] - w[1] * lever[:, 0])
-            noise = 8 * EPS * (abs(x[2]) + np.abs(rz))
-        else:
-            e3 = qt.body_axis(q)
-            d = x[None, :] - pts  # x − b_k
-            gap = d @ e3
-            lever = -d + gap[:, None] * e3[None, :]  # in-plane part of b_k − x
-            normal = np.broadcast_to(e3, lever.shape)
-            vn = v @ e3 + cross(w[None, :], lever) @ e3
-            noise = 8 * EPS * (np.abs(d) @ np.abs(e3))
+        R = qt.to_matrix(q)
+        # z-row computed from the small quaternion terms directly
+        wq, xq, yq, zq = q
+        lever = pts @ R.T
+        rz = pts[:, 0] * (2 * (xq * zq - wq * yq)) + pts[:, 1] * (2 * (yq * zq + wq * xq))
+        lever[:, 2] = rz
+        gap = x[2] + rz
+        normal = np.zeros_like(lever)
+        normal[:, 2] = 1.0
+        vn = v[2] + (w[0] * lever[:, 1] - w[1] * lever[:, 0])
+        noise = 8 * EPS * (abs(x[2]) + np.abs(rz))
+        return gap, normal, lever, vn, noise
+
+    def _bump_contacts(self, y: np.ndarray, pts: np.ndarray):
+        """World bumps under the face: gap (x − b)·e3, normal e3, lever in-plane b − x."""
+        x, q, v, w = y[X], y[Q], y[V], y[W]
+        e3 = qt.body_axis(q)
+        d = x[None, :] - pts  # x − b_k
+        gap = d @ e3
+        lever = -d + gap[:, None] * e3[None, :]  # in-plane part of b_k − x
+        normal = np.array(np.broadcast_to(e3, lever.shape))
+        vn = v @ e3 + cross(w[None, :], lever) @ e3
+        noise = 8 * EPS * (np.abs(d) @ np.abs(e3))
         return gap, normal, lever, vn, noise
 
     def jacobian(self, normal: np.ndarray, lever: np.ndarray) -> np.ndarray:
         """Rows J_k = [n_kᵀ, (r_k × n_k)ᵀ] mapping (v, ω) to normal velocities
         (flat ground: n = e_z, r × e_z = (r_y, −r_x, 0))."""
-        if self.flat:
+        if self.flat:  # the general row, written out (r × e_z = (r_y, −r_x, 0))
             J = np.zeros((len(lever), 6))
             J[:, 2] = 1.0
             J[:, 3] = lever[:, 1]
@@ -122,16 +181,21 @@ class BodyModel:
     def bias(self, y: np.ndarray, normal: np.ndarray, lever: np.ndarray, idx=None) -> np.ndarray:
         """Velocity-product part of the normal acceleration of each contact.
 
-        flat: (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z.
-        three_point: 2 v·(ω × e3) + (x − b)·(ω × (ω × e3))."""
+        rim vertex: (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z.
+        bump: 2 v·(ω × e3) + (x − b)·(ω × (ω × e3))."""
         v, w = y[V], y[W]
-        if self.flat:
-            return (lever @ w) * w[2] - float(w @ w) * lever[:, 2]
-        e3 = normal[0]
-        we3 = cross(w, e3)
-        pts = self.points if idx is None else self.points[idx]
-        d = y[X][None, :] - pts
-        return 2.0 * (v @ we3) + d @ cross(w, we3)
+        idx = np.arange(self.n_contacts) if idx is None else np.asarray(idx, dtype=int)
+        rim = idx < self.n_rim
+        out = np.empty(len(idx))
+        if rim.any():
+            r = lever[rim]
+            out[rim] = (r @ w) * w[2] - float(w @ w) * r[:, 2]
+        if not rim.all():
+            e3 = qt.body_axis(y[Q])
+            we3 = cross(w, e3)
+            d = y[X][None, :] - self.bumps[idx[~rim] - self.n_rim]
+            out[~rim] = 2.0 * (v @ we3) + d @ cross(w, we3)
+        return out
 
     def mass_matrix_inv(self, q: np.ndarray) -> np.ndarray:
         Minv = np.zeros((6, 6))

@@ -131,29 +131,39 @@ def _bracketed_root(p, dp, lo: float, hi: float, rel: float = 1e-3) -> float:
 def flight_bounds(model: BodyModel, fc: FlightConstants, horizon: float) -> tuple[float, float]:
     """(K, B): bounds on |g″| and |g‴| of every contact gap over a flight of `horizon`.
 
-    flat:  g″ = −g + (ω̇×r + ω×(ω×r))_z,  |r| = a
+    rim vertex:  g″ = −g + (ω̇×r + ω×(ω×r))_z,  |r| = a
            K = g + a(|ω|² + |ω̇|),  B = a(|ω̈| + 3|ω||ω̇| + |ω|³)
-    three_point: g = (x − b)·e3, e3 precessing at Ω about L:
+    bump: g = (x − b)·e3, e3 precessing at Ω about L:
            g″ = a·e3 + 2 v·ė3 + (x − b)·ë3,  g‴ = 3 a·ė3 + 3 v·ë3 + (x − b)·e3‴
            |ė3| ≤ Ω, |ë3| ≤ Ω², |e3‴| ≤ Ω³, |v| ≤ |v0| + g H, |x − b| ≤ D0 + |v0| H + g H²/2.
+    On a ground with both kinds (bumpy), the larger of each.
     """
+    K, B = 0.0, 0.0
+    if model.n_rim:
+        K, B = _rim_bounds(model, fc)
+    if len(model.bumps):
+        Kb, Bb = _bump_bounds(model, fc, horizon)
+        K, B = max(K, Kb), max(B, Bb)
+    return 1.0001 * K, 1.0001 * B
+
+
+def _rim_bounds(model: BodyModel, fc: FlightConstants) -> tuple[float, float]:
     g = fc.gravity
-    if model.flat:
-        w, wd, wdd = fc.omega_abs, fc.wdot_bound, fc.wddot_bound
-        a = model.radius
-        K = g + a * (w * w + wd)
-        B = a * (wdd + 3 * w * wd + w**3)
-        return 1.0001 * K, 1.0001 * B
+    w, wd, wdd = fc.omega_abs, fc.wdot_bound, fc.wddot_bound
+    a = model.radius
+    return g + a * (w * w + wd), a * (wdd + 3 * w * wd + w**3)
+
+
+def _bump_bounds(model: BodyModel, fc: FlightConstants, horizon: float) -> tuple[float, float]:
+    g = fc.gravity
     y0 = fc.y0
     H = horizon if math.isfinite(horizon) else 1e300
     v0 = float(np.linalg.norm(y0[V]))
     V_ = v0 + g * H
-    D = float(np.max(np.linalg.norm(y0[X][None, :] - model.points, axis=1))) + v0 * H
+    D = float(np.max(np.linalg.norm(y0[X][None, :] - model.bumps, axis=1))) + v0 * H
     D += 0.5 * g * H * H
     Om = fc.Omega
-    K = g + 2 * V_ * Om + D * Om * Om
-    B = 3 * g * Om + 3 * V_ * Om * Om + D * Om**3
-    return 1.0001 * K, 1.0001 * B
+    return g + 2 * V_ * Om + D * Om * Om, 3 * g * Om + 3 * V_ * Om * Om + D * Om**3
 
 
 # ------------------------------------------------------------------- flight search

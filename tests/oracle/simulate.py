@@ -174,8 +174,13 @@ class _Run:
 
 def excess_energy(model: BodyModel, y: np.ndarray) -> float:
     """Energy above the lowest level the invariants allow (body flat on the ground):
-    flat ground: E − ½ m |v_h|² − L_z² / (2 I3); three_point: E − ½ I3 ω3²."""
+    flat ground: E − ½ m |v_h|² − L_z² / (2 I3); three_point: E − ½ I3 ω3²; bumpy:
+    E − ½ I3 ω3² − m g z_rest (z_rest: the centre lying flat on the bumps; ω3 is
+    conserved once only the bumps push)."""
     E = model.energy(y)
+    if model.n_rim and len(model.bumps):
+        w3 = float(y[W] @ qt.body_axis(y[Q]))
+        return E - 0.5 * model.i3 * w3 * w3 - model.mass * model.gravity * model.rest_height
     if model.flat:
         v = y[V]
         Lz = float(model.angular_momentum(y)[2])
@@ -504,7 +509,14 @@ def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
             None,
         )
     k = hitting[0]
-    gap_k = float(model.contacts(y, [k])[0][0])
+    gap_k, _, lever_k, _, _ = model.contacts(y, [k])
+    if model.is_bump(k) and float(np.linalg.norm(lever_k[0])) > model.radius:
+        return (
+            Status.LEFT_MODEL,
+            f"bump contact {k} meets the face's plane outside the rim at t = {t:.17g}",
+            None,
+        )
+    gap_k = float(gap_k[0])
     run.stats["max_penetration"] = max(run.stats["max_penetration"], -gap_k)
     res = impact_impulse(model, y, k, run.gamma, watch=list(resting))
     vnoise = _rate_noise(model, y)
