@@ -63,7 +63,7 @@ def _edge_state(rng, n):
     """A tilted n-gon resting on its edge (vertices 0 and 1 at the ground)."""
     body = make_scene(n=n)
     model = BodyModel.from_scene(body)
-    edge = model.points[1] - model.points[0]
+    edge = model.vertices[1] - model.vertices[0]
     y = np.zeros(13)
     y[3:7] = qt.from_rotation_vector(0.4 * edge / np.linalg.norm(edge))
     y[2] = -model.contacts(y, np.array([0]))[0][0]
