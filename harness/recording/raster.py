@@ -64,7 +64,7 @@ def log_raster(rec: rr.RecordingStream, runs: list[RunView], contacts: GroundCon
     for run in runs:
         _log_impacts(rec, f"{RASTER}/{run.name}", run, contacts, biggest)
         _log_mismatch(rec, run)
-        _log_impact_text(rec, run)
+        _log_impact_text(rec, run, contacts)
 
 
 def bump_path(path: str) -> str:
