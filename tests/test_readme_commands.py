@@ -28,6 +28,13 @@ SMALL: dict[str, dict[str, list[str]]] = {
     "stress": {"--engine": ["mujoco"], "--case": ["grazing"]},
     "fidelity": {"--engine": ["mujoco"], "--dt": ["1e-3"], "--eps-grid": ["1:0.01:3"]},
     "sweep": {"--gyration": ["0.3:0.6:2"], "--restitution": ["0.2:0.4:2"], "--samples": ["5"]},
+    "restitution": {
+        "--engine": ["mujoco"],
+        "--gamma": ["0.8"],
+        "--speed": ["1"],
+        "--dt": ["1e-4"],
+        "--phase": ["0.5"],
+    },
 }
 
 
