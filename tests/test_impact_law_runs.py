@@ -188,3 +188,13 @@ def test_a_motion_that_ends_at_the_singularity_has_no_energy_left(sample):
     assert traj.status.value == "singularity"
     excess = excess_energy_of(traj, scene)
     assert excess[-1] <= 1e-9 * excess[0]
+
+
+def test_branches_text_fits_100_columns_and_names_each_branch(capsys):
+    """The terminal text of `harness branches` on the demo scene: one row per branch
+    (paper, moreau, sequential and both orders of the two contacts), no line over 100."""
+    assert main(["branches", "triangle-chatter"]) == 0
+    text = capsys.readouterr().out
+    rows = {line.split()[0] for line in text.splitlines() if line.strip()}
+    assert {"paper", "moreau", "sequential", "sequential[1,2]", "sequential[2,1]"} <= rows
+    assert max(len(line) for line in text.splitlines()) <= 100

@@ -3,7 +3,12 @@ branch (energy after it, the next impacts, final status, t_f, c)."""
 
 from __future__ import annotations
 
+import textwrap
+
 from ..text import num, table
+
+WIDTH = 100  # the terminal text fits this many columns
+NEXT_SHOWN = 2  # next impacts per row (the JSON has the first 4)
 
 
 def format_spread(spread) -> str:
@@ -19,15 +24,17 @@ def format_spread(spread) -> str:
     rows = []
     for b in [spread.paper, *spread.branches]:
         took = ",".join(str(r["contact"]) for r in b.impacts_at) or "-"
-        nxt = " ".join(f"{r['contact']}@{r['t'] - u['t']:.3g}" for r in b.next_impacts) or "-"
+        shown = b.next_impacts[:NEXT_SHOWN]
+        nxt = " ".join(f"{r['contact']}@{r['t'] - u['t']:.2g}" for r in shown) or "-"
         rows.append([b.name, took, num(b.energy_after, ".6g"), nxt, b.status,
-                     num(b.t_f, ".10g"), num(b.c, ".4g")])  # fmt: skip
-    header = ["branch", "impulses at t_u", "E after", "next impacts (contact@t - t_u)",
-              "status", "t_f", "c"]  # fmt: skip
+                     num(b.t_f, ".8g"), num(b.c, ".4g")])  # fmt: skip
+    header = ["branch", "at t_u", "E after", "next (k@t-t_u)", "status", "t_f", "c"]
     lines.append(table(rows, header, align="lllllrr"))
-    lines.append(
-        "E after: energy above the resting level just after t_u; t_f: t_singularity, else "
-        "the final time; c: the exponent of E = a (t_f - t)^c (runs reaching the "
-        "singularity)"
+    legend = (
+        "at t_u: the contacts that took an impulse at t_u; E after: energy above the "
+        "resting level just after t_u; next: the first impacts after t_u, contact k at "
+        "t - t_u (--json has 4); t_f: t_singularity, else the final time; c: the exponent "
+        "of E = a (t_f - t)^c (runs reaching the singularity)"
     )
+    lines += textwrap.wrap(legend, WIDTH)
     return "\n".join(lines)
