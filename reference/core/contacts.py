@@ -242,3 +242,17 @@ def reached_together(gap, rate, noise, tres0, window):
     SIMULTANEOUS_FACTOR × the sum of their time resolutions (the model cannot order
     them) plus the simultaneity window (model.window; 0: strictly sequential)."""
     return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0) + window
+
+
+@hot
+def approaching_contacts(y, model, pts, contacts, n, vnoise, out):
+    """The contacts[:n] approaching the ground at y, normal velocity g′ < −vnoise, to
+    `out`; returns how many (the paper's pushed contacts after an impact, the contacts
+    that hit when a contact phase reaches several together)."""
+    m = 0
+    for i in range(n):
+        kind = contact_kind(model, contacts[i])
+        if normal_velocity(y, contact_frame(y, kind, pts, contacts[i]), kind) < -vnoise:
+            out[m] = contacts[i]
+            m += 1
+    return m

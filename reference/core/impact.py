@@ -13,7 +13,7 @@ capture of a γ = 0 contact (reference.core.chatter, events; `bounce_ratio`,
 (reference.linear.kernel, reference.linear.model.impact_matrix), which call these
 functions."""
 
-from .contacts import contact_frame, contact_kind, normal_velocity
+from .contacts import approaching_contacts, contact_frame, contact_kind, normal_velocity
 from .inertia import apply_impulse, impulse_response
 from .jit import hot
 from .records import ImpactOutcome
@@ -70,10 +70,4 @@ def pushed_contacts(y, model, pts, held, n_held, vnoise, out):
     """The paper's rule beside held contacts: the held contacts that the impact just
     applied to y leaves approaching the ground (normal velocity < −vnoise) go to `out`;
     returns their number (0: the single-impact law stands)."""
-    n = 0
-    for i in range(n_held):
-        kind = contact_kind(model, held[i])
-        if normal_velocity(y, contact_frame(y, kind, pts, held[i]), kind) < -vnoise:
-            out[n] = held[i]
-            n += 1
-    return n
+    return approaching_contacts(y, model, pts, held, n_held, vnoise, out)

@@ -13,11 +13,11 @@ from .candidates import (
 )
 from .clock import grid_time, time_until, two_sum_add
 from .contacts import (
+    approaching_contacts,
     contact_frame,
     contact_kind,
     length_rate,
     length_scale,
-    normal_velocity,
     rate_noise,
     reached_together,
     time_resolution,
@@ -329,14 +329,7 @@ def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed
 def _approaching(y, model, pts, contacts, n, out):
     """The contacts[:n] approaching the ground at y (normal velocity below its roundoff)
     to out; returns how many."""
-    vnoise = rate_noise(y, model.radius)
-    m = 0
-    for i in range(n):
-        kind = contact_kind(model, contacts[i])
-        if normal_velocity(y, contact_frame(y, kind, pts, contacts[i]), kind) < -vnoise:
-            out[m] = contacts[i]
-            m += 1
-    return m
+    return approaching_contacts(y, model, pts, contacts, n, rate_noise(y, model.radius), out)
 
 
 @hot
