@@ -28,8 +28,8 @@ class ReferenceOptions:
       (reference.core.impact_laws; docs/architecture.md, "Impact laws"); None: the
       scene's `impact_law` (default `paper`).
     simultaneity_window: contacts reaching the ground within this time of each other
-      count as one simultaneous impact; None: the scene's (default 0, strictly
-      sequential as before).
+      count as one simultaneous impact; None: the scene's (default 1e-11; 0: strictly
+      sequential).
     sequential_order: the `sequential` law's order of contacts (sweeps over it); None:
       the fastest approaching first.
     """

@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from harness.cli import main
+from harness.scenes import resolve_scene
 from reference import ReferenceOptions, simulate
 from reference import quaternion as qt
-from reference.scene import SceneError, scene_from_dict
+from reference.scene import DEFAULT_SIMULTANEITY_WINDOW, SceneError, scene_from_dict
 from tests.conftest import make_scene
 from tests.oracle.body import BodyModel
 from tests.oracle.lcp import delassus, moreau_lcp
@@ -123,11 +124,14 @@ def test_every_output_names_the_law(tmp_path, capsys):
     )
     assert main(["simulate", str(path), "--impact-law", "moreau", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert (doc["impact_law"], doc["simultaneity_window"]) == ("moreau", 0.0)
+    assert (doc["impact_law"], doc["simultaneity_window"]) == (
+        "moreau",
+        DEFAULT_SIMULTANEITY_WINDOW,
+    )
     assert doc["status"] == "singularity" and doc["t_singularity"] == pytest.approx(3.0)
     assert len({r["t"] for r in doc["impacts"]}) == 1 and len(doc["impacts"]) == 6
     assert main(["simulate", str(path)]) == 0
-    assert "impact law  paper (simultaneity window 0)" in capsys.readouterr().out
+    assert "impact law  paper (simultaneity window 1e-11)" in capsys.readouterr().out
     assert main(["simulate", str(path), "--simultaneity-window", "-1"]) == 2
     assert main(["branches", str(path), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
@@ -142,27 +146,45 @@ def test_every_output_names_the_law(tmp_path, capsys):
 
 @pytest.mark.parametrize("case", list(STARTS))
 def test_a_start_just_above_the_ground_is_one_simultaneous_impact_within_the_window(case):
-    """The same states lifted 1e-12 above the ground: without a window the contacts are
-    met one by one a fraction of a picosecond apart; with a window of 1e-9 they are one
-    simultaneous impact, `simultaneous_impact` under the paper's rule, and under
-    Moreau's law the impulses of the start on the ground."""
+    """The same states lifted 1e-12 above the ground: with the default window
+    (DEFAULT_SIMULTANEITY_WINDOW) they are one simultaneous impact, `simultaneous_impact`
+    under the paper's rule, and under Moreau's law the impulses of the start on the
+    ground; with the window 0 the contacts are met one by one, a fraction of a
+    picosecond apart."""
     n, rot, v, w = STARTS[case]
     scene, y = _on_ground(n, rot, v, w)
     y_up = y.copy()
     y_up[2] += 1e-12
     lifted = make_scene(n=n, gamma=scene.restitution, state=y_up, t_end=0.5)
+    assert lifted.simultaneity_window == DEFAULT_SIMULTANEITY_WINDOW > 0
     on_ground = simulate(scene, options=ReferenceOptions(impact_law="moreau"))
-    windowed = ReferenceOptions(impact_law="moreau", simultaneity_window=1e-9)
-    above = simulate(lifted, options=windowed)
+    above = simulate(lifted, options=ReferenceOptions(impact_law="moreau"))
     first = [e for e in on_ground.impacts if e.t == 0.0]
     t0 = above.impacts[0].t
     again = [e for e in above.impacts if e.t == t0]
     assert [e.contact for e in again] == [e.contact for e in first]
     for a, b in zip(again, first, strict=True):
         assert a.impulse == pytest.approx(b.impulse, rel=1e-9)
-    paper = simulate(lifted, options=ReferenceOptions(simultaneity_window=1e-9))
+    paper = simulate(lifted)
     assert paper.status.value == "simultaneous_impact"
-    assert paper.simultaneity_window == 1e-9
+    assert paper.simultaneity_window == DEFAULT_SIMULTANEITY_WINDOW
+    strict = simulate(lifted, options=ReferenceOptions(simultaneity_window=0.0))
+    assert strict.status.value != "simultaneous_impact"
+    t0 = strict.impacts[0].t
+    micro = [e.t for e in strict.impacts if e.t - t0 < DEFAULT_SIMULTANEITY_WINDOW]
+    assert len(micro) >= 2 and len(set(micro)) == len(micro)  # single impacts, one by one
+
+
+def test_the_built_in_near_simultaneous_hits_are_one_impact_under_the_default_window():
+    """near-simultaneous: vertices 0 and 1 hit 1e-12 … 2e-12 apart (the scene sets the
+    window 0 to show them in order); under the default window they are one impact."""
+    scene = resolve_scene("near-simultaneous")
+    assert scene.simultaneity_window == 0.0
+    traj = simulate(
+        scene, options=ReferenceOptions(simultaneity_window=DEFAULT_SIMULTANEITY_WINDOW)
+    )
+    assert traj.status.value == "simultaneous_impact"
+    assert "[0, 1]" in traj.message and traj.impacts == []
 
 
 STALLS = "a contact phase stalls beside a vertex leaving a flat triangle (issue 31, open)"

@@ -54,13 +54,24 @@ def config_from_args(args) -> SweepConfig:
         dt=float(dt) if (dt is not None and is_fixed_step(args.engine)) else None,
         min_decades=default_min_decades(args.engine),
         impact_law=getattr(args, "impact_law", None) or "paper",
-        simultaneity_window=float(getattr(args, "simultaneity_window", None) or 0.0),
+        simultaneity_window=sweep_window(args),
         **extra,
     )
-    if getattr(args, "simultaneity_window", None) and args.engine != "reference":
+    if getattr(args, "simultaneity_window", None) is not None and args.engine != "reference":
         raise _bad("--simultaneity-window applies to the reference engine only")
     check_config(config)
     return config
+
+
+def sweep_window(args) -> float:
+    """The reference's simultaneity window: the option, else the scenes' default
+    (`reference.scene.DEFAULT_SIMULTANEITY_WINDOW`); 0 (none) for the other engines."""
+    from reference.scene import DEFAULT_SIMULTANEITY_WINDOW
+
+    window = getattr(args, "simultaneity_window", None)
+    if window is not None:
+        return float(window)
+    return DEFAULT_SIMULTANEITY_WINDOW if args.engine == "reference" else 0.0
 
 
 def check_config(config: SweepConfig) -> None:

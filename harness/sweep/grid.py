@@ -48,7 +48,7 @@ class SweepConfig:
     t_end: float = 200.0
     min_decades: float = 6.0
     impact_law: str = "paper"  # the reference's law of simultaneous impacts
-    simultaneity_window: float = 0.0  # and its window
+    simultaneity_window: float = 0.0  # and its window (0 in manifests without the key)
 
     def to_dict(self) -> dict:
         d = asdict(self)
