@@ -14,7 +14,8 @@ engine, the linear model) is set against each branch after t_u:
   at t_u);
 - energy: the energy above the resting level E at t_e = t_u + the energy guard
   (harness.metrics.energy_guard: 3 steps for fixed-step runs, 0 event-driven), the
-  run's against the branch's, over the reference's E just before t_u (E_u).
+  run's against the branch's, over the reference's E just before t_u (E_u; the
+  absolute difference if E_u is not positive, a body with no energy left to share).
 
 Distance (dimensionless): d = d_impacts + d_energy with
 
