@@ -14,6 +14,8 @@ from harness.branches.follow import follow_branches
 from harness.branches.spread import branches
 from harness.cli import main
 from harness.compare import compare, format_compare
+from harness.scenes import resolve_scene
+from reference.trajectory import ImpactEvent
 from tests.test_impact_law_runs import STARTS, _on_ground
 
 BRANCH_FIELDS = {
@@ -104,6 +106,10 @@ def _check_engine_branch(result, label):
 
 def test_the_demo_scene_names_the_branch_mujoco_follows(demo):
     _check_engine_branch(demo, "mujoco 1e-04")
+    from harness.recording import branch_notes
+
+    notes = branch_notes(demo)  # the recording's summary tab
+    assert any(line.startswith("- mujoco 1e-04") for line in notes)
 
 
 @pytest.mark.slow
@@ -128,3 +134,38 @@ def test_the_json_has_every_branch_field_and_the_report_reads_it(demo, tmp_path)
     out = tmp_path / "report.html"
     assert main(["report", str(path), "--out", str(out)]) == 0
     assert row["branch"]["sentence"] in out.read_text().replace("&#x27;", "'")
+
+
+def _resting_after(traj, t_end: float, extra_impacts=()):
+    """The run `traj` held at its last state until t_end, with `extra_impacts` added."""
+
+    def longer(a):
+        return np.concatenate([a, a[-1:]])
+
+    return dataclasses.replace(
+        traj, engine="synthetic", t=np.append(traj.t, t_end), position=longer(traj.position),
+        quaternion=longer(traj.quaternion), velocity=longer(traj.velocity),
+        angular_velocity=longer(traj.angular_velocity),
+        kinetic_energy=longer(traj.kinetic_energy),
+        potential_energy=longer(traj.potential_energy),
+        impacts=[*traj.impacts, *extra_impacts],
+    )  # fmt: skip
+
+
+def test_a_branch_at_rest_is_left_by_the_first_real_bounce_after_it():
+    """triangle-chatter's moreau branch ends at the singularity: a run that is that
+    branch and then rests stays with it to its end; one that bounces (at a speed no
+    chatter tail has) after the branch came to rest leaves it at that bounce."""
+    scene = resolve_scene("triangle-chatter")
+    spread = branches(scene)
+    moreau = next(b for b in spread.branches if b.name == "moreau")
+    assert moreau.status == "singularity"
+    t_rest = moreau.trajectory.t[-1]
+    rests = _resting_after(moreau.trajectory, 1.0)
+    follow = follow_branches(rests, spread, scene, None)
+    by_name = {c.branch: c for c in follow.candidates}
+    assert by_name["moreau"].until == 1.0
+    bounce = ImpactEvent(t_rest + 0.1, 0, 1.0, -1.0, 0.5)
+    bounces = _resting_after(moreau.trajectory, 1.0, [bounce])
+    by_name = {c.branch: c for c in follow_branches(bounces, spread, scene, None).candidates}
+    assert by_name["moreau"].until == bounce.t

@@ -28,7 +28,10 @@ disagreement; 1 for an extra run impact where the branch has fewer than K).  The
 nearest branch has the least d (ties: the first in the branches' order).  How far the
 run stays with it: k of its N impacts after t_u (in the common window) reproduced in
 order (s tails skipped on the way: k+s/N), until the first disagreement, or the end of
-the common window when there is none.  The choice is *decided* when the next nearest
+the common window when there is none; a branch that ends at the singularity is at rest
+from then on (`stays_until`): a run impact after that, faster than the chatter tails, is
+a disagreement (and counts as an extra impact in d_impacts), and a run without one stays
+with the branch to its own end.  The choice is *decided* when the next nearest
 branch of another distance is more than DECIDED_MARGIN (1 %) of the nearest's distance
 farther; branches at exactly the nearest's distance (in practice the same run: the
 sequential law in the order it would choose anyway) are taken as its outcome.
@@ -147,6 +150,20 @@ def walk_start(run: Trajectory, branch: Trajectory, t_u: float, tolerance) -> tu
     return i, j
 
 
+def stays_until(run: Trajectory, b: Branch, tail_speed: float) -> float:
+    """Where a run that agrees with branch `b` as far as both go stops agreeing: a
+    branch that ends at the singularity is at rest from then on, so the run's first
+    impact after it that is not slower than `tail_speed` (a chatter tail); the run's end
+    without one.  Other branches: the end of the common window."""
+    if b.status != "singularity":
+        window = common_window(run, b.trajectory)
+        return window[1] if window else float(run.t[-1])
+    t_rest = float(b.trajectory.t[-1])
+    t = run.impact_times()
+    fast = (t > t_rest) & (np.abs(run.impact_column("v_normal_pre")) >= tail_speed)
+    return float(t[fast][0]) if fast.any() else float(run.t[-1])
+
+
 def branch_distance(
     run: Trajectory,
     b: Branch,
@@ -167,10 +184,11 @@ def branch_distance(
                if i < i0 + first]  # fmt: skip
     skipped = sum(1 for i in m.skipped_reference_indices if i < i0 + first)
     unreproduced = first - len(offsets) - skipped
-    if m.mismatch is not None and unreproduced == 0 and first < NEXT_IMPACTS:
+    until = m.mismatch_time if m.mismatch is not None else stays_until(run, b, tol.tail_speed)
+    bounces_after_rest = b.status == "singularity" and until < float(run.t[-1])
+    disagrees = m.mismatch is not None or bounces_after_rest
+    if disagrees and unreproduced == 0 and first < NEXT_IMPACTS:
         unreproduced = 1  # an extra run impact where the branch has no more
-    window = common_window(run, b.trajectory)
-    until = m.mismatch_time if m.mismatch is not None else (window[1] if window else None)
     e_b = excess_at(*b.energy_curve, t_e)
     e_dist = math.inf if energy_run is None or e_b is None else abs(energy_run - e_b) / e_u
     return BranchDistance(

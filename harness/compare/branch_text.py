@@ -35,13 +35,18 @@ def branch_sentence(run: EngineRun) -> str | None:
     b = run.branch
     if b is None:
         return None
-    n = b.nearest
-    head = f"{run.label} follows {n.branch} (distance {n.distance:.3g}"
-    r = b.runner_up
-    if r is not None:
-        head += f"; next {r.branch} {r.distance:.3g}{'' if b.decided else ', undecided'}"
+    n, r = b.nearest, b.runner_up
+    if r is None or b.decided:
+        head = f"{run.label} follows {n.branch} (distance {n.distance:.3g}"
+        head += "" if r is None else f"; next {r.branch} {r.distance:.3g}"
+    else:
+        head = (f"{run.label} is as near to {n.branch} as to {r.branch} (distance "
+                f"{n.distance:.3g} and {r.distance:.3g}: undecided")  # fmt: skip
     until = "-" if n.until is None else f"{n.until:.7g} s"
-    text = f"{head}): {impacts_text(n)} of its impacts after t_u, until t = {until}"
+    text = (
+        f"{head}): it reproduces {impacts_text(n)} of {n.branch}'s impacts after t_u, "
+        f"until t = {until}"
+    )
     if not b.followed_reference:
         text += "; it had left the reference before t_u"
     return text + "."
