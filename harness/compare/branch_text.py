@@ -26,7 +26,7 @@ def runner_up_text(b: BranchFollow) -> str:
     """'sequential 1.56', with '≈ ' before it when the choice is not decided."""
     r = b.runner_up
     if r is None:
-        return "-"
+        return "≈ every branch" if len(b.candidates) > 1 else "-"
     return f"{'' if b.decided else '≈ '}{r.branch} {r.distance:.3g}"
 
 
@@ -36,7 +36,9 @@ def branch_sentence(run: EngineRun) -> str | None:
     if b is None:
         return None
     n, r = b.nearest, b.runner_up
-    if r is None or b.decided:
+    if r is None and len(b.candidates) > 1:
+        head = f"{run.label} is as near to every branch (distance {n.distance:.3g}: undecided"
+    elif r is None or b.decided:
         head = f"{run.label} follows {n.branch} (distance {n.distance:.3g}"
         head += "" if r is None else f"; next {r.branch} {r.distance:.3g}"
     else:
