@@ -484,6 +484,21 @@ def _impacts_now(F, q, p, qs, ps, closed, vfl):
     return ncand, cand, cand2
 
 
+@njit(cache=True)
+def law_contacts(F, q, p, qs, ps, vfl, out):
+    """The contacts of a simultaneous impact under an impact law (issue 31): every
+    contact touching the ground within roundoff and not separating beyond it (normal
+    velocity f_cᵀp ≤ its roundoff level), into out; returns how many.  Held contacts
+    (resting) are in, a contact leaving is not: a law's impulse on a separating contact
+    could do positive work (docs/architecture.md, "Impact laws")."""
+    n = 0
+    for c in range(F.shape[0]):
+        if _touching(F, c, q, qs) and _dot(F, c, p) <= _tol(F, c, ps, vfl):
+            out[n] = c
+            n += 1
+    return n
+
+
 @_helper
 def _any_closed(closed):
     """Whether any contact is closed, i.e. the body is not in free flight (the paper,

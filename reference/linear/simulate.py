@@ -70,6 +70,7 @@ class LinearRun:
     p_post: np.ndarray | None
     acc: np.ndarray | None
     wall_time_s: float
+    impact_law: str = "paper"  # the law of simultaneous impacts applied (laws.py)
 
     @property
     def impact_rows(self) -> np.ndarray:
@@ -124,6 +125,7 @@ def run_linear(
     chatter_tol: float = 1e-7,
     decouple_tol: float = 1e-6,
     record_states: bool = True,
+    impact_law: str = "paper",
 ) -> LinearRun:
     """Run the linear model from (q0, p0) at t = 0 until t_end, the singularity (all
     contacts down, or energy below `energy_floor` × initial), an undecidable impact, or
@@ -132,7 +134,38 @@ def run_linear(
     Chatter at one contact is completed in closed form once it is provably alone and its
     post-impact normal velocity is ≤ `chatter_tol` × the velocity scale √(2E max f Θ⁻¹f)
     (`math.inf`: as soon as it is provably alone); `decouple_tol` is the same threshold
-    for completing without the proof and for two-contact accumulations (kernel.py)."""
+    for completing without the proof and for two-contact accumulations (kernel.py).
+
+    `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
+    or `moreau` / `sequential`: the run goes on past it under that law (laws.py)."""
+    if impact_law != "paper":
+        from .laws import run_under_law
+
+        return run_under_law(
+            model, q0, p0, impact_law, t_end=t_end, max_impacts=max_impacts,
+            energy_floor=energy_floor, chatter_tol=chatter_tol, decouple_tol=decouple_tol,
+            record_states=record_states,
+        )  # fmt: skip
+    return run_segment(
+        model, q0, p0, t_end, max_impacts, energy_floor, chatter_tol, decouple_tol,
+        record_states,
+    )[0]  # fmt: skip
+
+
+def run_segment(
+    model: LinearModel,
+    q0,
+    p0,
+    t_end: float,
+    max_impacts: int,
+    energy_floor: float,
+    chatter_tol: float,
+    decouple_tol: float,
+    record_states: bool,
+) -> tuple[LinearRun, tuple]:
+    """`run_linear` under the paper's rule, with the kernel's loop state at the stop
+    (kernel.new_loop_state: the normalised q, p, their roundoff scales, ..., si, sf):
+    where a law continues the run (laws.py)."""
     q0 = np.array(q0, dtype=float)
     p0 = np.array(p0, dtype=float)
     F = model.F
@@ -182,8 +215,9 @@ def run_linear(
     dtn = of[:, K.F_DTN]
     with np.errstate(divide="ignore"):
         log2_dt = np.where(dtn > 0, np.log2(np.where(dtn > 0, dtn, 1.0)), -np.inf) + oi[:, K.I_DTE]
-    msg = _message(status, reason, info, of, n, int(info[2]))
-    return LinearRun(
+    t_stop = of[n - 1, K.F_THI] + of[n - 1, K.F_TLO] if n else 0.0
+    msg = run_message(status, reason, t_stop, int(info[2]), (int(info[3]), int(info[4])))
+    run = LinearRun(
         model=model,
         status=status,
         reason=reason,
@@ -206,13 +240,15 @@ def run_linear(
         wall_time_s=wall,
         **states,
     )
+    return run, loop
 
 
-def _message(status: Status, reason: int, info, of, n: int, n_imp: int) -> str:
-    t = of[n - 1, K.F_THI] + of[n - 1, K.F_TLO] if n else 0.0
+def run_message(status: Status, reason: int, t: float, n_imp: int, pair=(-1, -1)) -> str:
+    """The message of a run that stopped at t with `status` and `reason` (REASON_*),
+    after n_imp impacts; `pair`: the two contacts of an undecidable event."""
     what = _REASONS.get(reason, "")
     if status is Status.SIMULTANEOUS_IMPACT:
-        return f"undecidable at t = {t:.17g}: {what} (contacts {int(info[3])} and {int(info[4])})"
+        return f"undecidable at t = {t:.17g}: {what} (contacts {pair[0]} and {pair[1]})"
     if status is Status.SINGULARITY:
         return f"{what} at t = {t:.17g} after {n_imp} impacts"
     if status is Status.MAX_IMPACTS:
@@ -270,6 +306,7 @@ def simulate_linear(
         max_impacts=scene.run.max_impacts,
         energy_floor=energy_floor,
         chatter_tol=chatter_tol,
+        impact_law=scene.impact_law,
     )
     exit_at = first_exit(run)
     if exit_at is not None:  # beyond the small tilts the model holds for (domain.py)
@@ -380,7 +417,7 @@ def trajectory_from_run(
         phases=phases,
         stats=stats,
         t_lo=lo_all,
-        impact_law="paper",  # the linear kernel applies the paper's rule only (so far)
+        impact_law=run.impact_law,
         simultaneity_window=0.0,
     )
 
