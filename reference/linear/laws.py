@@ -7,7 +7,9 @@ when a chatter accumulates) it stops `simultaneous_impact` on the state before t
 impact.  Under `moreau` or `sequential` the run goes on from there (`run_under_law`):
 
 1. the contacts of the impact: every contact touching the ground within roundoff and
-   not separating (`kernel.law_contacts`; held contacts included);
+   not separating (`kernel.law_contacts`; held contacts included), and those the
+   kernel found reached within the simultaneity window (their gaps, at most T|u|, are
+   not closed: as in the exact core);
 2. their Delassus matrix in the linear model, W = F_S Θ⁻¹ F_Sᵀ (w_ab = f_aᵀΘ⁻¹f_b, the
    change of contact a's normal velocity per unit impulse at b: `kernel._contact_products`,
    from Θ Δp = Σ f_b λ_b of the linearised Newton–Euler equations, paper eqs. Theta,
@@ -292,7 +294,7 @@ def _approaching(F, q, p, ps, contacts, vfl) -> bool:
 
 def run_under_law(
     model, q0, p0, law: str, *, t_end: float, max_impacts: int, energy_floor: float,
-    chatter_tol: float, decouple_tol: float, record_states: bool,
+    chatter_tol: float, decouple_tol: float, record_states: bool, window: float = 0.0,
 ):  # fmt: skip
     """`simulate.run_linear` under `law` (`moreau` or `sequential`): kernel segments
     under the paper's rule, each undecidable stop resolved by the law and the kernel
@@ -313,7 +315,7 @@ def run_under_law(
         floor = energy_floor * e_init / e_now if e_init > 0 and e_now > 0 else energy_floor
         t_left = max(t_end - (o_hi + o_lo), 0.0) if math.isfinite(t_end) else math.inf
         seg, loop = run_segment(model, q, p, t_left, max(max_impacts - n_imp, 0), floor,
-                                chatter_tol, decouple_tol, record_states)  # fmt: skip
+                                chatter_tol, decouple_tol, record_states, window)  # fmt: skip
         wall += seg.wall_time_s
         n_imp += seg.n_impacts
         first = 1 if parts else 0  # a restart's INITIAL row: its held set goes to the last
@@ -338,7 +340,10 @@ def run_under_law(
             same_time, last_t, e_last = 0, t_hi, e_stop
         qn, pn, qs, ps, kv, kq, gt, e_n, vfl = _stop_state(model, loop)
         idx = np.zeros(model.n_contacts, dtype=np.int64)
-        contacts = idx[: K.law_contacts(F, qn, pn, qs, ps, vfl, idx)].copy()
+        contacts = idx[: K.law_contacts(F, qn, pn, qs, ps, vfl, idx)]
+        if seg.reason == K.REASON_WINDOW:  # with those reached within the window
+            contacts = np.union1d(contacts, np.flatnonzero(loop[12]))
+        contacts = np.array(contacts, dtype=np.int64)
         if same_time >= MAX_RESTARTS_AT_ONE_TIME:
             parts.append(end_row)
             message = f"the {law} law made no progress at t = {t_hi:.17g}: stopped (undecidable)"
@@ -383,7 +388,7 @@ def run_under_law(
     rows = _concat(parts)
     return LinearRun(
         model=model, status=status, reason=reason, message=message, n_impacts=n_imp,
-        wall_time_s=wall, impact_law=law, **rows,
+        wall_time_s=wall, impact_law=law, simultaneity_window=float(window), **rows,
     )  # fmt: skip
 
 

@@ -71,6 +71,7 @@ class LinearRun:
     acc: np.ndarray | None
     wall_time_s: float
     impact_law: str = "paper"  # the law of simultaneous impacts applied (laws.py)
+    simultaneity_window: float = 0.0  # contacts reached within it count as one impact
 
     @property
     def impact_rows(self) -> np.ndarray:
@@ -94,6 +95,7 @@ _REASONS = {
     K.REASON_FAILED_LCP: "no admissible set of held contacts",
     K.REASON_BUFFER_FULL: "event buffer full",
     K.REASON_FAILED_NO_ADVANCE: "no further event and no end time",
+    K.REASON_WINDOW: "contacts reached within the simultaneity window of each other",
 }
 
 
@@ -126,6 +128,7 @@ def run_linear(
     decouple_tol: float = 1e-6,
     record_states: bool = True,
     impact_law: str = "paper",
+    simultaneity_window: float = 0.0,
 ) -> LinearRun:
     """Run the linear model from (q0, p0) at t = 0 until t_end, the singularity (all
     contacts down, or energy below `energy_floor` × initial), an undecidable impact, or
@@ -137,19 +140,22 @@ def run_linear(
     for completing without the proof and for two-contact accumulations (kernel.py).
 
     `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
-    or `moreau` / `sequential`: the run goes on past it under that law (laws.py)."""
+    or `moreau` / `sequential`: the run goes on past it under that law (laws.py).
+    `simultaneity_window`: open contacts reaching the ground within this time of the
+    first are reached together with it (0: strictly sequential, as before issue 31)."""
     if impact_law != "paper":
         from .laws import run_under_law
 
         return run_under_law(
             model, q0, p0, impact_law, t_end=t_end, max_impacts=max_impacts,
             energy_floor=energy_floor, chatter_tol=chatter_tol, decouple_tol=decouple_tol,
-            record_states=record_states,
+            record_states=record_states, window=simultaneity_window,
         )  # fmt: skip
-    return run_segment(
+    run = run_segment(
         model, q0, p0, t_end, max_impacts, energy_floor, chatter_tol, decouple_tol,
-        record_states,
+        record_states, simultaneity_window,
     )[0]  # fmt: skip
+    return run
 
 
 def run_segment(
@@ -162,6 +168,7 @@ def run_segment(
     chatter_tol: float,
     decouple_tol: float,
     record_states: bool,
+    window: float = 0.0,
 ) -> tuple[LinearRun, tuple]:
     """`run_linear` under the paper's rule, with the kernel's loop state at the stop
     (kernel.new_loop_state: the normalised q, p, their roundoff scales, ..., si, sf):
@@ -190,7 +197,8 @@ def run_segment(
     while not done:  # back in Python every LOOP_BUDGET events: Ctrl-C works
         n = K.continue_kernel(
             *consts, model.restitution, model.rank, float(t_end), int(max_impacts),
-            float(log2_floor), float(chatter_tol), float(decouple_tol), bool(record_states),
+            float(log2_floor), float(chatter_tol), float(decouple_tol), float(window),
+            bool(record_states),
             out_i, out_f, out_s, info, *loop, LOOP_BUDGET,
         )  # fmt: skip
         done = n >= 0
@@ -238,6 +246,7 @@ def run_segment(
         energy_post=np.ldexp(of[:, K.F_EPOST], 2 * kv),
         log2_energy=of[:, K.F_LOG2E].copy(),
         wall_time_s=wall,
+        simultaneity_window=float(window),
         **states,
     )
     return run, loop
@@ -307,6 +316,7 @@ def simulate_linear(
         energy_floor=energy_floor,
         chatter_tol=chatter_tol,
         impact_law=scene.impact_law,
+        simultaneity_window=scene.simultaneity_window,
     )
     exit_at = first_exit(run)
     if exit_at is not None:  # beyond the small tilts the model holds for (domain.py)
@@ -418,7 +428,7 @@ def trajectory_from_run(
         stats=stats,
         t_lo=lo_all,
         impact_law=run.impact_law,
-        simultaneity_window=0.0,
+        simultaneity_window=run.simultaneity_window,
     )
 
 
