@@ -36,6 +36,7 @@ impact's time (the first carries the interval before it, the others 0).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -126,10 +127,24 @@ def apply_law(F, theta, gamma, p, contacts, law: int, complete_below: float = 0.
 SELF_SIMILAR_TOL = 1e-9
 
 
-def bounce_series_time(model, p_post, contacts, u_post, law: int, vfl: float, g: float):
-    """The time a Zeno series of self-similar bounces takes from an impact at q = 0
-    (every contact touching), or None when the impact does not start one (p_post, u_post,
-    vfl, gravity g and the time returned in the kernel's normalised units).
+@dataclass(frozen=True)
+class BounceSeries:
+    """A Zeno series of self-similar bounces (`bounce_series`), in the kernel's
+    normalised units: the first flight 2/κ, the whole series' duration 2/(κ(1 − γ)),
+    and the first landing's impulses and normal velocities (bounce k: × γ^(k−1))."""
+
+    flight: float
+    duration: float
+    lam: np.ndarray
+    u_pre: np.ndarray
+    u_post: np.ndarray
+    held: tuple[int, ...]
+
+
+def bounce_series(model, p_post, contacts, u_post, law: int, vfl: float, g: float):
+    """The Zeno series of self-similar bounces an impact at q = 0 (every contact
+    touching) starts, or None when it starts none (p_post, u_post, vfl, gravity g and
+    the times in the kernel's normalised units).
 
     With B the contacts resting after the impact (u⁺ = 0) held, the acceleration a is
     constant (model.held_acceleration, forces η ≥ 0).  If a = −κ p⁺ (κ > 0), the motion
@@ -159,11 +174,70 @@ def bounce_series_time(model, p_post, contacts, u_post, law: int, vfl: float, g:
     if not kappa > 0.0 or float(resid @ (theta * resid)) > SELF_SIMILAR_TOL**2 * kappa**2 * norm2:
         return None
     p_next = -p_post
-    status = apply_law(model.F, theta, gamma, p_next, contacts, law)[0]
+    status, lam, u_pre, u_next, _, _ = apply_law(model.F, theta, gamma, p_next, contacts, law)
     miss = p_next - gamma * p_post
     if status != SETTLED or float(miss @ (theta * miss)) > SELF_SIMILAR_TOL**2 * norm2:
         return None
-    return 2.0 / (kappa * (1.0 - gamma))
+    flight = 2.0 / kappa
+    return BounceSeries(flight, flight / (1.0 - gamma), lam, u_pre, u_next, tuple(rest))
+
+
+def _series_rows(model, series: BounceSeries, contacts, kv: int, kq: int, t_hi: float,
+                 t_lo: float, q, p_post, e_floor: float, budget: int, record: bool):  # fmt: skip
+    """The bounces of a self-similar series as IMPACT rows (one per contact that takes
+    an impulse; closed form: bounce k at t + (2/κ)(1 − γ^k)/(1 − γ), everything else
+    × γ^(k−1)) while the energy before a bounce is above e_floor and at most `budget`
+    rows, then the END row at rest at t + 2/(κ(1 − γ)).  Inputs q, p_post in true
+    units, series in normalised ones; the rows' values in true units."""
+    gamma = model.restitution
+    flight = math.ldexp(series.flight, kq - kv)
+    took = np.flatnonzero(series.lam > 0.0)
+    held = np.full(2, -1, dtype=np.int64)
+    held[: min(len(series.held), 2)] = series.held[:2]
+    acc = held_acceleration_of(model, series.held)
+    cols: dict[str, list] = {f: [] for f in ROW_FIELDS + STATE_FIELDS}
+    q = np.zeros(3)  # every contact at the ground: q = 0 (the impact's q within roundoff)
+    k, n = 1, 0
+    while n + len(took) <= budget:
+        r = gamma ** (k - 1)
+        e_pre = model.energy(q, -r * p_post)
+        if not (e_pre > e_floor and flight * r > 0.0):
+            break
+        e_post = model.energy(q, gamma * r * p_post)
+        since = flight * (1.0 - gamma**k) / (1.0 - gamma)
+        tk_hi, tk_lo = _shift(np.array([since]), np.zeros(1), t_hi, t_lo)
+        for i, c in enumerate(took):
+            row = dict(
+                kind=K.IMPACT, contact=contacts[c], contact2=-1, held=held,
+                dt=flight * r if i == 0 else 0.0,
+                log2_dt=math.log2(flight * r) if i == 0 else -math.inf,
+                t_hi=tk_hi[0], t_lo=tk_lo[0], impulse=math.ldexp(series.lam[c] * r, kv),
+                v_pre=math.ldexp(series.u_pre[c] * r, kv),
+                v_post=math.ldexp(series.u_post[c] * r, kv), energy_pre=e_pre,
+                energy_post=e_post, log2_energy=math.log2(e_post),
+                q_pre=q, p_pre=-r * p_post, q_post=q, p_post=gamma * r * p_post, acc=acc,
+            )  # fmt: skip
+            for f, v in row.items():
+                cols[f].append(v)
+        n += len(took)
+        k += 1
+    rows = {f: np.array(v) if v else np.zeros((0, 3) if f in STATE_FIELDS else 0)
+            for f, v in cols.items()}  # fmt: skip
+    if not record:
+        rows.update(q_pre=None, p_pre=None, q_post=None, p_post=None, acc=None)
+    rows["held"] = rows["held"].reshape(-1, 2)
+    for f in ("kind", "contact", "contact2", "held"):
+        rows[f] = rows[f].astype(np.int64)
+    return [rows]
+
+
+def held_acceleration_of(model, held) -> np.ndarray:
+    """The constant acceleration with the contacts `held` held (model.held_acceleration)
+    in true units."""
+    from .model import held_acceleration
+
+    f = model.F[list(held)] if held else np.zeros((0, 3))
+    return held_acceleration(f, model.theta, model.mass, model.gravity)[0]
 
 
 def _shift(t_hi, t_lo, o_hi: float, o_lo: float):
@@ -228,9 +302,9 @@ def _concat(parts: list[dict]) -> dict:
 
 
 def _rest_row(model, row: dict, t_hi: float, t_lo: float, tail: float, q, p, contacts):
-    """The END row of a completed flat bounce: at rest at t + tail on all contacts (the
-    coordinates the contacts see are 0; the rod's roll about its axis, which they do not
-    see, carried on for the tail)."""
+    """The END row of a completed bounce series: at rest at t + tail on all contacts
+    (the coordinates the contacts see are 0; the rod's roll about its axis, which they
+    do not see, carried on for the tail); its interval is from the last row (`row`)."""
     F, tinv = model.F, 1.0 / model.theta
     idx = np.asarray(contacts[:3], dtype=np.int64)
     q_r = np.asarray(q, dtype=float) + np.asarray(p, dtype=float) * tail
@@ -239,11 +313,12 @@ def _rest_row(model, row: dict, t_hi: float, t_lo: float, tail: float, q, p, con
     K._project(p_r, F, tinv, idx, len(idx))
     e = model.energy(q_r, p_r)
     t_f_hi, t_f_lo = _shift(np.array([tail]), np.zeros(1), t_hi, t_lo)
-    rows = {f: row[f][:1].copy() for f in ROW_FIELDS}
+    rows = {f: row[f][-1:].copy() for f in ROW_FIELDS}
+    dt = float((t_f_hi[0] - row["t_hi"][-1]) + (t_f_lo[0] - row["t_lo"][-1]))
     rows.update(
         kind=np.array([K.END]), contact=np.array([-1]), contact2=np.array([-1]),
-        dt=np.array([tail]), log2_dt=np.array([math.log2(tail)]), t_hi=t_f_hi,
-        t_lo=t_f_lo, impulse=np.zeros(1), v_pre=np.zeros(1), v_post=np.zeros(1),
+        dt=np.array([dt]), log2_dt=np.array([math.log2(dt) if dt > 0 else -math.inf]),
+        t_hi=t_f_hi, t_lo=t_f_lo, impulse=np.zeros(1), v_pre=np.zeros(1), v_post=np.zeros(1),
         energy_pre=np.array([e]), energy_post=np.array([e]),
         log2_energy=np.array([math.log2(e) if e > 0 else -math.inf]),
     )  # fmt: skip
@@ -369,12 +444,17 @@ def run_under_law(
                 reason = K.REASON_ENERGY_EXHAUSTED if e_post > 0 else K.REASON_NO_ENERGY
                 message = run_message(status, reason, t_hi, n_imp)
                 break
-            tail = bounce_series_time(model, p_post, contacts, u_post, law_id, vfl, gt)
-            if tail is not None and math.isfinite(tail):
-                tail = math.ldexp(tail, kq - kv)  # the normalised time in true units
+            series = bounce_series(model, p_post, contacts, u_post, law_id, vfl, gt)
+            tail = None if series is None else math.ldexp(series.duration, kq - kv)
             if tail is not None and t_hi + tail <= t_end:
-                rest, t_f = _rest_row(model, rows, t_hi, t_lo, tail, q_true,
-                                      np.ldexp(p_post, kv), contacts)  # fmt: skip
+                p_true = np.ldexp(p_post, kv)
+                bounces = _series_rows(model, series, contacts, kv, kq, t_hi, t_lo, q_true,
+                                       p_true, energy_floor * e_init, max_impacts - n_imp,
+                                       record_states)  # fmt: skip
+                parts += bounces
+                n_imp += len(bounces[0]["kind"])
+                last = bounces[0] if len(bounces[0]["kind"]) else rows
+                rest, t_f = _rest_row(model, last, t_hi, t_lo, tail, q_true, p_true, contacts)
                 parts.append(rest)
                 status, reason = Status.SINGULARITY, K.REASON_SINGULARITY
                 message = (

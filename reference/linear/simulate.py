@@ -441,6 +441,8 @@ def run_linear_exponent(
     g: float = 1.0,
     max_impacts: int = 20000,
     energy_floor: float = 1e-24,
+    impact_law: str = "paper",
+    simultaneity_window: float = 0.0,
 ) -> dict:
     """One run of the paper's exponent study (section 4.3): the n-gon (a = m = 1) from
     (q0, p0) with gravity g until the singularity, an undecidable impact or
@@ -450,7 +452,9 @@ def run_linear_exponent(
     runs, as in the paper, or fewer than 6 decades of energy in the fit window),
     c_stderr, t_singularity (None unless the singularity was reached), n_impacts, and
     the cross-check estimates c_decades (durations of energy decades, no t_f needed) and
-    c_period (ratios over one period of a periodic impact pattern, when there is one)."""
+    c_period (ratios over one period of a periodic impact pattern, when there is one).
+    `impact_law`, `simultaneity_window`: as for `run_linear` (under `paper` an
+    undecidable run has no c, as in the paper)."""
     from .exponent_estimates import exponent_of_run
 
     base = {
@@ -475,6 +479,8 @@ def run_linear_exponent(
         energy_floor=energy_floor,
         chatter_tol=math.inf,
         record_states=False,
+        impact_law=impact_law,
+        simultaneity_window=simultaneity_window,
     )
     out = dict(base)
     out.update(
