@@ -260,3 +260,15 @@ def test_the_law_is_named_for_every_linear_run():
         run = run_linear(LinearModel.polygon(4, 0.5, 0.5), (0.01, 0.0, 0.02), (0, 0, 0),
                          t_end=1.0, impact_law=law)  # fmt: skip
         assert run.impact_law == law
+
+
+def test_the_harness_runs_the_linear_model_under_a_law_and_names_it():
+    from harness.simulators import run_simulator
+    from reference.scenes import as_scene
+
+    scene = as_scene("triangle-chatter").with_impact_law("moreau", 1e-9)
+    traj = run_simulator("linear", scene)
+    assert traj.status is Status.SINGULARITY
+    summary = traj.summary(with_impacts=False)
+    assert summary["impact_law"] == "moreau"
+    assert summary["simultaneity_window"] == 1e-9
