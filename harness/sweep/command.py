@@ -57,8 +57,8 @@ def config_from_args(args) -> SweepConfig:
         simultaneity_window=float(getattr(args, "simultaneity_window", None) or 0.0),
         **extra,
     )
-    if getattr(args, "simultaneity_window", None) and args.engine != "reference":
-        raise _bad("--simultaneity-window applies to the reference engine only")
+    if getattr(args, "simultaneity_window", None) and args.engine not in ("reference", "linear"):
+        raise _bad("--simultaneity-window applies to the reference and linear engines only")
     check_config(config)
     return config
 
