@@ -194,11 +194,6 @@ def check_run(
     fixed-step engines 0 < dt <= t_end and t_end / dt <= max_steps
     (DEFAULT_MAX_STEPS).  Returns the timestep the engine gets (None: not fixed-step)."""
     simulate = load_engine(engine)
-    if engine == "linear" and scene.impact_law != "paper":
-        raise SceneError(
-            f"the linear model applies only the paper's impact law in this build, not "
-            f"{scene.impact_law!r}"
-        )
     if dt is not None and not (math.isfinite(dt) and dt > 0):
         raise SceneError(f"dt must be > 0, got {dt}")
     # t_end (or the scene's own) in range, with the speed group, like [run]: the one

@@ -117,6 +117,15 @@ def test_document_has_the_contract_fields_and_is_strict_json(calls):
     assert doc["engines"][1]["effective_restitution"] == pytest.approx(0.5)
 
 
+def test_without_an_undecidable_state_there_are_no_branches(calls):
+    """A reference that does not end simultaneous_impact: `branch` and `branches` are
+    null and the text has no branches paragraph."""
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    doc = result.to_dict()
+    assert doc["branches"] is None and doc["engines"][0]["branch"] is None
+    assert "undecidable state at t_u" not in C.format_compare(result)
+
+
 def test_table_has_one_row_per_run(calls):
     result = C.compare(resolve_scene("pentagon-bounce"), ["pybullet", "mujoco"], dts=[1e-3])
     text = C.format_compare(result)

@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from reference.trajectory import Trajectory
+
 # impacts after t_u listed per branch
 NEXT_IMPACTS = 4
 # orders of the sequential law are tried for at most this many touching contacts
@@ -41,6 +43,7 @@ class Branch:
     c: float | None
     c_stderr: float | None
     energy_curve: tuple[np.ndarray, np.ndarray] = field(repr=False, default=None)  # t, E
+    trajectory: Trajectory | None = field(repr=False, default=None)  # the whole run
 
     @property
     def t_f(self) -> float:
@@ -135,18 +138,26 @@ def summarise(traj, scene, name, law, order, t_u) -> Branch:
         name=name, law=law, order=order, status=traj.status.value, message=traj.message,
         t_final=traj.t_final, t_singularity=traj.t_singularity, energy_after=e_after,
         impacts_at=at, next_impacts=after[:NEXT_IMPACTS], n_impacts=len(traj.impacts),
-        c=c, c_stderr=c_err, energy_curve=(traj.t.copy(), np.asarray(energy)),
+        c=c, c_stderr=c_err, energy_curve=(traj.t.copy(), np.asarray(energy)), trajectory=traj,
     )  # fmt: skip
 
 
 def branches(scene, t_end: float | None = None, progress=None) -> Spread:
     """The paper's run, its first undecidable state, and every branch from there."""
     from reference import simulate
-    from reference.continuation import touching_contacts
 
     t_end = float(t_end if t_end is not None else scene.run.t_end)
     scene = scene.with_impact_law("paper")
-    paper_traj = simulate(scene, t_end=t_end)
+    return branches_from(scene, t_end, simulate(scene, t_end=t_end), progress)
+
+
+def branches_from(scene, t_end: float, paper_traj: Trajectory, progress=None) -> Spread:
+    """Every branch from the first undecidable state of `paper_traj`, the scene's run
+    under the paper's rule to `t_end` (made here by `branches`, by `harness compare`
+    as its reference)."""
+    from reference.continuation import touching_contacts
+
+    scene = scene.with_impact_law("paper")
     undecidable = None
     t_u = None
     contacts: list[int] = []

@@ -8,6 +8,11 @@ recorded as a run with status `failed` and the exception as its message, so one 
 engine does not hide the others' results; bad input (`SceneError`) still stops the
 command.
 
+When the reference ends `simultaneous_impact` (the paper's rule at an undecidable state,
+t_u), the scene is continued from there under every impact law (harness.branches.spread)
+and each run gets the branch it follows after t_u and how far it stays with it
+(harness.branches.follow); otherwise `branch` is None.
+
 Text output: `text.format_compare` (100 columns, one verdict line per run; `wide=True`
 for every column); the impact-by-impact diff: `diff.impact_diff` (`--out`).  The columns
 are defined in docs/output.md.
@@ -23,8 +28,10 @@ from typing import Any
 from reference.exponent import ExponentFit
 from reference.scene import Scene, SceneError
 from reference.scenes import as_scene
-from reference.trajectory import Trajectory
+from reference.trajectory import Status, Trajectory
 
+from ..branches.follow import BranchFollow, follow_branches
+from ..branches.spread import Spread, branches_from
 from ..horizon.settings import DEFAULT_SEED
 from ..horizon.verdict import Horizon, engine_horizon, planned_members, scene_horizon
 from ..metrics import RunMetrics, effective_restitution, evaluate, run_exponent
@@ -43,6 +50,7 @@ class EngineRun:
     metrics: RunMetrics
     exponent: ExponentFit
     horizon: Horizon | None = None
+    branch: BranchFollow | None = None
 
     @property
     def label(self) -> str:
@@ -62,6 +70,7 @@ class EngineRun:
         doc.update(self.metrics.to_dict())
         doc["exponent"] = self.exponent.to_dict()
         doc["horizon"] = None if self.horizon is None else self.horizon.to_dict()
+        doc["branch"] = None if self.branch is None else self.branch.to_dict()
         return doc
 
 
@@ -72,6 +81,7 @@ class CompareResult:
     reference_wall_time_s: float
     runs: list[EngineRun]
     reference_exponent: ExponentFit | None = None
+    spread: Spread | None = None  # the branches at the reference's undecidable state
 
     def first_to_diverge(self) -> EngineRun | None:
         """The run whose first divergence from the reference comes earliest (None if
@@ -81,6 +91,7 @@ class CompareResult:
 
     def to_dict(self) -> dict[str, Any]:
         """The contract's `compare` document, plus the exponents and the verdicts."""
+        from .branch_text import branch_sentence
         from .text import divergence_sentence, horizon_sentence, verdict_line
 
         ref = self.reference.summary(with_impacts=False)
@@ -96,6 +107,8 @@ class CompareResult:
             row["verdict"] = verdict_line(run, self.scene)
             if row["horizon"] is not None:
                 row["horizon"]["sentence"] = horizon_sentence(run)
+            if row["branch"] is not None:
+                row["branch"]["sentence"] = branch_sentence(run)
             engines.append(row)
         return {
             "kind": "compare",
@@ -105,6 +118,7 @@ class CompareResult:
             "simultaneity_window": self.reference.simultaneity_window,
             "reference": ref,
             "engines": engines,
+            "branches": None if self.spread is None else branches_summary(self.spread),
             "first_to_diverge": None
             if first is None
             else {
@@ -160,7 +174,36 @@ def compare(
             bar.update()
     if horizon_runs > 0:
         add_horizons(scene, reference, runs, horizon_runs, horizon_seed, say)
-    return CompareResult(scene, reference, ref_wall, runs, run_exponent(reference, scene))
+    spread = add_branches(scene, reference, runs, t_end, say)
+    return CompareResult(scene, reference, ref_wall, runs, run_exponent(reference, scene), spread)
+
+
+def add_branches(
+    scene: Scene,
+    reference: Trajectory,
+    runs: list[EngineRun],
+    t_end: float | None,
+    say: Callable[[str], None],
+) -> Spread | None:
+    """When the reference ends `simultaneous_impact`: the branches from there
+    (harness.branches.spread) and the one each run follows (harness.branches.follow)."""
+    if reference.status is not Status.SIMULTANEOUS_IMPACT:
+        return None
+    start = time.perf_counter()
+    t_end = float(t_end if t_end is not None else scene.run.t_end)
+    spread = branches_from(scene, t_end, reference)
+    for r in runs:
+        r.branch = follow_branches(r.trajectory, spread, scene, r.metrics.first_divergence_time)
+    say(f"compare: {len(spread.branches)} branches at t_u = {reference.t_final:.9g} s ("
+        f"{time.perf_counter() - start:.2f} s)")  # fmt: skip
+    return spread
+
+
+def branches_summary(spread: Spread) -> dict[str, Any]:
+    """The `branches` field of the compare document: the undecidable state and one entry
+    per branch (as in `harness branches --json`)."""
+    doc = spread.to_dict()
+    return {"undecidable": doc["undecidable"], "branches": doc["branches"][1:]}
 
 
 def add_horizons(

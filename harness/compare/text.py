@@ -13,6 +13,7 @@ from reference.trajectory import Status
 
 from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
 from ..text import impact_law_text, table
+from .branch_text import branch_lines, branch_sentence
 
 if TYPE_CHECKING:
     from . import CompareResult, EngineRun
@@ -312,6 +313,9 @@ def format_compare(result: CompareResult, wide: bool = False) -> str:
     lines = [*_header(result), "", _verdict_table(result), ""]
     lines += _first_to_diverge(result)
     lines += _failures(result)
+    branches = branch_lines(result)
+    if branches:
+        lines += ["", *branches]
     lines += ["", *textwrap.wrap(LEGEND, WIDTH)]
     return "\n".join(lines)
 
@@ -392,5 +396,7 @@ def format_compare_wide(result: CompareResult) -> str:
             lines.append(f"  {run.label}: {m.divergence_reason}")
         if run.exponent.c is None and run.exponent.reason:
             lines.append(f"  {run.label}: no c: {run.exponent.reason}")
+        if run.branch is not None:
+            lines.append(f"  after t_u: {branch_sentence(run)}")
     lines += _failures(result)
     return "\n".join(lines)

@@ -32,7 +32,7 @@ import numpy as np
 from reference import Trajectory
 from reference.scene import Scene
 
-from ..metrics import ENERGY_GUARD_STEPS, ImpactMatch
+from ..metrics import ImpactMatch, energy_guard
 from .ensemble import (
     Member,
     grid_ensemble,
@@ -134,7 +134,7 @@ def own_error(
     state carried s by its closed-form flight."""
     if run.n_samples == 0:
         return None, None
-    guard = ENERGY_GUARD_STEPS * float(run.dt) if run.dt is not None else 0.0
+    guard = energy_guard(run)
     t_ref, t_run = reference.impact_times(), run.impact_times()
     post = post_impact_states(reference)
     rows = np.concatenate([run.position, run.quaternion, run.velocity, run.angular_velocity], 1)

@@ -37,7 +37,12 @@ from .attitude import (  # noqa: F401  (the package's API)
     first_divergence_time,
     largest_tilt,
 )
-from .energy import ENERGY_GUARD_STEPS, energy_error, energy_error_series  # noqa: F401
+from .energy import (  # noqa: F401
+    ENERGY_GUARD_STEPS,
+    energy_error,
+    energy_error_series,
+    energy_guard,
+)
 from .matching import (  # noqa: F401
     EVENT_TIME_TOLERANCE,
     RELATIVE_TIME_TOLERANCE,

@@ -15,6 +15,12 @@ ENERGY_GUARD_STEPS = 3.0
 # ----------------------------------------------------------------------------- energy
 
 
+def energy_guard(run: Trajectory) -> float:
+    """How long after an impact a run's energy is not read (s): ENERGY_GUARD_STEPS·dt
+    (3 steps) for fixed-step runs, 0 for event-driven ones."""
+    return ENERGY_GUARD_STEPS * float(run.dt) if run.dt is not None else 0.0
+
+
 def energy_error_series(
     run: Trajectory,
     reference: Trajectory,
@@ -45,7 +51,7 @@ def energy_error_series(
     if window is None:
         return np.zeros(0), np.zeros(0)
     if guard is None:
-        guard = ENERGY_GUARD_STEPS * float(run.dt) if run.dt is not None else 0.0
+        guard = energy_guard(run)
     t = run.t
     inside = (t >= window[0]) & (t <= window[1])
     excluded = _impact_exclusion(run, reference, tolerance, guard)

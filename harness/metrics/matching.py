@@ -229,7 +229,12 @@ class ImpactMatch:
         return len(self.pairs)
 
 
-def match_impacts(run: Trajectory, reference: Trajectory, tolerance: MatchTolerance) -> ImpactMatch:
+def match_impacts(
+    run: Trajectory,
+    reference: Trajectory,
+    tolerance: MatchTolerance,
+    start: tuple[int, int] = (0, 0),
+) -> ImpactMatch:
     """Leading impacts matched.  The two sequences are walked in order; the next run
     impact matches the next reference impact when both have the same contact index and
     |t_run − t_ref| ≤ w_i (`impact_windows`).  When they do not match and the earlier of
@@ -242,7 +247,9 @@ def match_impacts(run: Trajectory, reference: Trajectory, tolerance: MatchTolera
     in swapped order are a mismatch even when both are within the window: which point
     hits first decides the motion after it.  Only impacts inside the common window take
     part (run impacts up to one window past its end, so a late match at the very end
-    still counts, but never as spurious)."""
+    still counts, but never as spurious).  `start` = (i, j): the walk begins at reference
+    impact i and run impact j (the impacts after a given time, harness.branches.follow);
+    chatter tails are still judged on the whole sequences."""
     window = common_window(run, reference)
     if window is None:
         return ImpactMatch(np.zeros((0, 2), int), np.zeros(0), None, None, 0, 0, 0)
@@ -258,7 +265,7 @@ def match_impacts(run: Trajectory, reference: Trajectory, tolerance: MatchTolera
     skipped_r: list[int] = []
     skipped_e = 0
     mismatch: Mismatch | None = None
-    i = j = 0
+    i, j = start
     while i < n_r or (j < n_e and te[j] <= t_end):
         if i < n_r and j < n_e:
             if ce[j] == cr[i] and abs(te[j] - tr[i]) <= wr[i]:

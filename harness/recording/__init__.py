@@ -101,7 +101,21 @@ def record_comparison(
         fits = None
     runs = build_runs(trajs, result.scene, metrics=metrics, fits=fits)
     horizons = [None, *[r.horizon for r in kept]]
-    return _write(runs, result.scene, path, force=force, horizons=horizons)
+    notes = branch_notes(result)
+    return _write(runs, result.scene, path, force=force, horizons=horizons, notes=notes)
+
+
+def branch_notes(result: CompareResult) -> list[str]:
+    """The summary's paragraph on the branches after the reference's undecidable state
+    (harness.compare.branch_text), one sentence per run; [] without one."""
+    from ..compare.branch_text import branch_sentence
+
+    sentences = [s for s in (branch_sentence(r) for r in result.runs) if s]
+    if not sentences:
+        return []
+    u = result.spread.undecidable
+    head = f"After the undecidable state at t_u = {u['t']:.7g} s, the branch each run follows:"
+    return [head, *[f"- {s}" for s in sentences]]
 
 
 def _row_ranges(runs: list[RunView], n_contacts: int) -> RowRanges:
@@ -128,6 +142,7 @@ def _write(
     contact_tolerance: float | None = None,
     force: bool = False,
     horizons: list | None = None,
+    notes: list[str] | None = None,
 ) -> Path:
     out = Path(path)
     tol = 1e-6 * scene.body.radius if contact_tolerance is None else contact_tolerance
@@ -163,7 +178,7 @@ def _write(
             log_horizon_bands(rec, runs, horizons, n_contacts)
         log_energy_plot(rec, runs, e_plot)
         log_alpha_plot(rec, runs, a_plot)
-        text = summary_markdown(runs, scene, t_max)
+        text = summary_markdown(runs, scene, t_max, notes)
         rec.log(SUMMARY, rr.TextDocument(text, media_type="text/markdown"), static=True)
         reading = rr.TextDocument(reading_markdown(), media_type="text/markdown")
         rec.log(READING, reading, static=True)

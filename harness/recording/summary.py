@@ -60,7 +60,11 @@ def _run_line(run: RunView, scene: Scene) -> str:
     return "; ".join(parts)
 
 
-def summary_markdown(runs: list[RunView], scene: Scene, t_max: float) -> str:
+def summary_markdown(
+    runs: list[RunView], scene: Scene, t_max: float, notes: list[str] | None = None
+) -> str:
+    """The summary tab; `notes`: paragraphs after the runs' lines (compare: the branch
+    each run follows after the reference's undecidable state)."""
     lines = [
         f"# {scene.name}",
         "",
@@ -72,6 +76,8 @@ def summary_markdown(runs: list[RunView], scene: Scene, t_max: float) -> str:
         "",
         *[_run_line(run, scene) for run in runs],
     ]
+    for note in notes or []:
+        lines += ["", note]
     return "\n".join(lines)
 
 

@@ -50,6 +50,21 @@ HORIZON = Opt(
 )
 PROVENANCE = Opt({"command?": "str", "created?": "str", "host?": "str", "versions?": Each("any")})
 EXPONENT = Opt({"c?": NUM})
+# compare: the branch a run follows after the reference's undecidable state
+BRANCH = Opt(
+    {
+        "branch": "str",
+        "law": "str",
+        "impacts": "int",
+        "skipped": "int",
+        "of": "int",
+        "until": NUM,
+        "distance": NUM,
+        "decided": "bool",
+        "sentence?": Opt("str"),
+        "candidates": [{"branch": "str", "distance": NUM}],
+    }
+)
 
 COMPARE = {
     "scene": "str",
@@ -75,6 +90,7 @@ COMPARE = {
             "verdict?": Opt("str"),
             "exponent?": EXPONENT,
             "horizon?": HORIZON,
+            "branch?": BRANCH,
         }
     ],
     "first_to_diverge?": Opt({"why": "str"}),

@@ -119,8 +119,20 @@ def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
     if first:
         parts.append(paragraph(f"First to diverge: {first['why']}"))
     parts.append(_horizon_paragraphs(doc))
+    parts += _branch_paragraphs(doc)
     parts.append(recording_link(doc.get("recording"), out_dir))
     return "\n".join(parts)
+
+
+def _branch_paragraphs(doc: dict[str, Any]) -> list[str]:
+    """After the reference's undecidable state: the branch each run follows (the
+    engines' `branch.sentence`, docs/output.md); nothing when there is none."""
+    sentences = [(e.get("branch") or {}).get("sentence") for e in doc["engines"]]
+    sentences = [s for s in sentences if s]
+    if not sentences:
+        return []
+    head = "After the undecidable state: the branch each run follows (harness branches)"
+    return [f"<h3>{head}</h3>", *[paragraph(s) for s in sentences]]
 
 
 def _band(q: list[float] | None) -> str:

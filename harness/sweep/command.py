@@ -57,21 +57,27 @@ def config_from_args(args) -> SweepConfig:
         simultaneity_window=sweep_window(args),
         **extra,
     )
-    if getattr(args, "simultaneity_window", None) is not None and args.engine != "reference":
-        raise _bad("--simultaneity-window applies to the reference engine only")
+    if getattr(args, "simultaneity_window", None) is not None and not takes_window(args.engine):
+        raise _bad("--simultaneity-window applies to the reference and linear engines only")
     check_config(config)
     return config
 
 
 def sweep_window(args) -> float:
-    """The reference's simultaneity window: the option, else the scenes' default
-    (`reference.scene.DEFAULT_SIMULTANEITY_WINDOW`); 0 (none) for the other engines."""
+    """The simultaneity window of the reference and the linear model: the option, else
+    the scenes' default (`reference.scene.DEFAULT_SIMULTANEITY_WINDOW`); 0 (none) for
+    the other engines."""
     from reference.scene import DEFAULT_SIMULTANEITY_WINDOW
 
     window = getattr(args, "simultaneity_window", None)
     if window is not None:
         return float(window)
-    return DEFAULT_SIMULTANEITY_WINDOW if args.engine == "reference" else 0.0
+    return DEFAULT_SIMULTANEITY_WINDOW if takes_window(args.engine) else 0.0
+
+
+def takes_window(engine: str) -> bool:
+    """The event-driven simulators resolve simultaneous impacts under a window."""
+    return engine in ("reference", "linear")
 
 
 def check_config(config: SweepConfig) -> None:

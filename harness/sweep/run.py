@@ -54,8 +54,9 @@ def run_linear_sample(config: SweepConfig, rho: float, gamma: float, q0, p0) -> 
     from reference.linear.simulate import run_linear_exponent
 
     r = run_linear_exponent(
-        config.n, rho, gamma, q0, p0, g=config.gravity, max_impacts=config.max_impacts
-    )
+        config.n, rho, gamma, q0, p0, g=config.gravity, max_impacts=config.max_impacts,
+        impact_law=config.impact_law, simultaneity_window=config.simultaneity_window,
+    )  # fmt: skip
     return {
         "status": str(r["status"]),
         "c": r.get("c"),

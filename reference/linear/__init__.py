@@ -3,6 +3,7 @@
 - model:       f_k, Θ, U_k, R, a_contact, energy; LinearModel (n-gon or three bumps)
 - kernel:      compiled exact event loop (quadratic motion, roots of quadratics)
 - simulate:    run_linear (raw events), simulate_linear (Trajectory), run_linear_exponent
+- laws:        the run past undecidable states under the core's impact laws (moreau, sequential)
 - selfsimilar: self-similar motion: β, feasibility, stability of the reduced map C̄
 - chatter:     R⁻¹U0 eigenvalues, CC / PCC, the rod's β_p, β_q, c_lin
 - exponent:    the energy exponent c (regression on log(t_f − t), decade durations, period)

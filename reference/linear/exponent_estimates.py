@@ -29,6 +29,7 @@ from ..exponent import (  # noqa: F401  (the one estimator; re-exported for the 
     SKIP_END,
     SKIP_START,
     _log2_sum,
+    distinct_impacts,
     extrapolate_time_to_go,
     fit_energy_exponent,
     fit_log_energy_exponent,
@@ -139,8 +140,12 @@ def exponent_of_run(
         return out
     out["log10_energy_drop"] = float((lE[0] - lE[fin][-1]) / LOG2_10)
     lrem = extrapolate_time_to_go(run.log2_dt, lE)
+    if run.impact_law != "paper" and run.reason == K.REASON_SINGULARITY:
+        lrem = -math.inf  # at rest at the last row's time (a bounce series' closed form)
     out["log2_time_remaining"] = lrem
     imp = np.flatnonzero((run.kind == K.IMPACT) | (run.kind == K.ACCUMULATION))
+    if run.impact_law != "paper":  # a simultaneous impact's rows are one impact
+        imp = imp[distinct_impacts(run.t_hi[imp], run.t_lo[imp])]
     if lrem is None or len(imp) < 8:
         return out
     lttg = K.log2_time_to_go(np.ascontiguousarray(run.log2_dt), float(lrem))

@@ -8,6 +8,11 @@ positive root of one; roots are taken in cancellation-free form (`first_hit`).  
   held at that moment must come out separating or resting (paper §2.3), otherwise the
   impact is undecidable, as are two contacts reached at once (status SIMULTANEOUS);
 - accumulation of a chatter sequence (Zeno), completed in closed form (below);
+- with a simultaneity window T > 0 (issue 31), open contacts reaching the ground
+  within T of the one reached first are reached together with it: status SIMULTANEOUS
+  (REASON_WINDOW) on the state where the first is reached, the others flagged in
+  `together` (their gaps, at most T|u|, not closed); an impact law resolves it
+  (laws.py);
 - at every event the held set is re-solved: forces from F_B Θ⁻¹ F_Bᵀ η = g 1 over the
   subsets B of the closed contacts; the admissible one has η ≥ 0 and no closed contact
   with negative normal acceleration (an LCP by enumeration; rank(F) closed contacts is
@@ -43,7 +48,9 @@ set and the motion to the next event (`_flight_step`).  The helpers share the ru
 small tuples and arrays, unpacked at their top:
 
     model   = (F, thd, tinv, w, wmax, mass, gamma, rank_f)   constants of the body
-    limits  = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol)
+    limits  = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol, window,
+               together)   the run's limits; the simultaneity window T (0: none) and the
+              contacts it found reached together (an output, read by laws.py)
     state   = (q, p, qs, ps, acc, held, closed)   normalised state, roundoff scales of q
               and p, acceleration of the segment, held contacts, closed contacts
     scratch = (q_pre, p_pre, qn, pn, work, cidx, hidx, sidx)   work vectors, index lists
@@ -95,6 +102,7 @@ REASON_SINGULARITY = 7  # all contacts down (rank(F) closed)
 REASON_FAILED_LCP = 8  # no admissible set of held contacts
 REASON_BUFFER_FULL = 9  # the event buffer is full
 REASON_FAILED_NO_ADVANCE = 10  # no further event and no end time
+REASON_WINDOW = 11  # contacts reached within the simultaneity window of each other
 N_INFO = 8  # status, n_events, n_impacts, contact_a, contact_b, reason
 RB = 64  # ring buffer of recent impacts
 # integer run state `si`: scale exponents kv, kq; rows written; impacts resolved; ring
@@ -484,6 +492,21 @@ def _impacts_now(F, q, p, qs, ps, closed, vfl):
     return ncand, cand, cand2
 
 
+@njit(cache=True)
+def law_contacts(F, q, p, qs, ps, vfl, out):
+    """The contacts of a simultaneous impact under an impact law (issue 31): every
+    contact touching the ground within roundoff and not separating beyond it (normal
+    velocity f_cᵀp ≤ its roundoff level), into out; returns how many.  Held contacts
+    (resting) are in, a contact leaving is not: a law's impulse on a separating contact
+    could do positive work (docs/architecture.md, "Impact laws")."""
+    n = 0
+    for c in range(F.shape[0]):
+        if _touching(F, c, q, qs) and _dot(F, c, p) <= _tol(F, c, ps, vfl):
+            out[n] = c
+            n += 1
+    return n
+
+
 @_helper
 def _any_closed(closed):
     """Whether any contact is closed, i.e. the body is not in free flight (the paper,
@@ -603,7 +626,7 @@ def _impact_step(model, limits, state, scratch, ring, out, si, sf, info, j, E, v
     (REASON_ENERGY_EXHAUSTED: the singularity, the paper, section 1), then complete a
     chatter sequence in free flight (0 < γ < 1) where possible."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
-    t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol = limits
+    t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol = limits[:5]
     q, p, qs, ps, acc, held, closed = state
     if si[SI_IMPACTS] >= max_impacts or si[SI_EVENTS] + 3 >= out[0].shape[0]:
         _stop(si, info, MAX_IMPACTS, REASON_NONE, -1, -1)
@@ -721,7 +744,7 @@ def _chatter_plan(model, limits, state, sidx, ring, si, sf, j, E, vpre):
     Exact: v⁺ ≤ chatter_tol V, T = 2v⁺/(g(1−γ)) before t_end and j provably alone;
     otherwise `_decoupled_chatter` once |v⁻| ≤ decouple_tol V, if T comes before t_end."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
-    t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol = limits
+    t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol = limits[:5]
     q, p, qs, ps, acc, held, closed = state
     gt = sf[SF_GRAVITY]
     vplus = _dot(F, j, p)
@@ -960,6 +983,11 @@ def _flight_step(model, limits, state, scratch, out, si, sf, info, vfl):
             return
         tmin = max(rem, 0.0)
         jmin = -1
+    other = -1
+    if limits[5] > 0.0 and jmin >= 0:  # the simultaneity window (0: skipped)
+        window = math.ldexp(limits[5], si[SI_KV] - si[SI_KQ])
+        other = _reached_together(F, q, p, qs, ps, acc, closed, vfl, jmin, tmin + window,
+                                  limits[6])  # fmt: skip
     _advance(q, p, qs, ps, acc, tmin)
     if nh > 0:
         _project(q, F, tinv, hidx, nh)
@@ -975,6 +1003,27 @@ def _flight_step(model, limits, state, scratch, out, si, sf, info, vfl):
     sf[SF_T_HI] = t_hi
     sf[SF_T_LO] = t_lo
     sf[SF_DT_PENDING] = tmin
+    if other >= 0:
+        _stop(si, info, SIMULTANEOUS, REASON_WINDOW, jmin, other)
+
+
+@_helper
+def _reached_together(F, q, p, qs, ps, acc, closed, vfl, jmin, t_window, together):
+    """The simultaneity window (issue 31): the open contacts other than jmin that reach
+    the ground by t_window (normalised) are reached together with it; they and jmin are
+    flagged in `together` (cleared first).  Returns one of them, −1 if none."""
+    other = -1
+    for c in range(F.shape[0]):
+        together[c] = False
+    for c in range(F.shape[0]):
+        if closed[c] or c == jmin:
+            continue
+        if _time_to_contact(F, c, q, p, qs, ps, acc, vfl) <= t_window:
+            together[c] = True
+            other = c
+    if other >= 0:
+        together[jmin] = True
+    return other
 
 
 # ------------------------------------------------------------------ the event loop
@@ -1044,6 +1093,7 @@ def new_loop_state(n_contacts: int):
         np.full(RB, -1, dtype=np.int64),  # ring: contact
         np.zeros(RB),  # ring: log2 interval
         np.zeros(RB),  # ring: log2 speed
+        np.zeros(n_contacts, dtype=np.bool_),  # together: reached in one window
     )
 
 
@@ -1085,15 +1135,15 @@ def start_kernel(
 @njit(cache=True)
 def continue_kernel(
     F, thd, tinv, w, wmax, mass, gamma, rank_f, t_end, max_impacts, log2_energy_floor,
-    chatter_tol, decouple_tol, record_states, out_i, out_f, out_s, info,
-    q, p, qs, ps, acc, held, closed, si, sf, rb_c, rb_ldt, rb_lu, budget,
+    chatter_tol, decouple_tol, window, record_states, out_i, out_f, out_s, info,
+    q, p, qs, ps, acc, held, closed, si, sf, rb_c, rb_ldt, rb_lu, together, budget,
 ):  # fmt: skip
     """At most `budget` passes of the event loop (`_step`), so that the caller regains
     control (Ctrl-C) between calls.  Returns the number of events once a status is set
     (after `_finish`: END row, outcome record), else -1: call again."""
     nc = F.shape[0]
     model = (F, thd, tinv, w, wmax, mass, gamma, rank_f)
-    limits = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol)
+    limits = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol, window, together)
     out = (out_i, out_f, out_s, record_states)
     state = (q, p, qs, ps, acc, held, closed)
     cidx = np.zeros(nc + 3, dtype=np.int64)

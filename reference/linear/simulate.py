@@ -70,6 +70,8 @@ class LinearRun:
     p_post: np.ndarray | None
     acc: np.ndarray | None
     wall_time_s: float
+    impact_law: str = "paper"  # the law of simultaneous impacts applied (laws.py)
+    simultaneity_window: float = 0.0  # contacts reached within it count as one impact
 
     @property
     def impact_rows(self) -> np.ndarray:
@@ -93,6 +95,7 @@ _REASONS = {
     K.REASON_FAILED_LCP: "no admissible set of held contacts",
     K.REASON_BUFFER_FULL: "event buffer full",
     K.REASON_FAILED_NO_ADVANCE: "no further event and no end time",
+    K.REASON_WINDOW: "contacts reached within the simultaneity window of each other",
 }
 
 
@@ -124,6 +127,8 @@ def run_linear(
     chatter_tol: float = 1e-7,
     decouple_tol: float = 1e-6,
     record_states: bool = True,
+    impact_law: str = "paper",
+    simultaneity_window: float = 0.0,
 ) -> LinearRun:
     """Run the linear model from (q0, p0) at t = 0 until t_end, the singularity (all
     contacts down, or energy below `energy_floor` × initial), an undecidable impact, or
@@ -132,7 +137,42 @@ def run_linear(
     Chatter at one contact is completed in closed form once it is provably alone and its
     post-impact normal velocity is ≤ `chatter_tol` × the velocity scale √(2E max f Θ⁻¹f)
     (`math.inf`: as soon as it is provably alone); `decouple_tol` is the same threshold
-    for completing without the proof and for two-contact accumulations (kernel.py)."""
+    for completing without the proof and for two-contact accumulations (kernel.py).
+
+    `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
+    or `moreau` / `sequential`: the run goes on past it under that law (laws.py).
+    `simultaneity_window`: open contacts reaching the ground within this time of the
+    first are reached together with it (0: strictly sequential, as before issue 31)."""
+    if impact_law != "paper":
+        from .laws import run_under_law
+
+        return run_under_law(
+            model, q0, p0, impact_law, t_end=t_end, max_impacts=max_impacts,
+            energy_floor=energy_floor, chatter_tol=chatter_tol, decouple_tol=decouple_tol,
+            record_states=record_states, window=simultaneity_window,
+        )  # fmt: skip
+    run = run_segment(
+        model, q0, p0, t_end, max_impacts, energy_floor, chatter_tol, decouple_tol,
+        record_states, simultaneity_window,
+    )[0]  # fmt: skip
+    return run
+
+
+def run_segment(
+    model: LinearModel,
+    q0,
+    p0,
+    t_end: float,
+    max_impacts: int,
+    energy_floor: float,
+    chatter_tol: float,
+    decouple_tol: float,
+    record_states: bool,
+    window: float = 0.0,
+) -> tuple[LinearRun, tuple]:
+    """`run_linear` under the paper's rule, with the kernel's loop state at the stop
+    (kernel.new_loop_state: the normalised q, p, their roundoff scales, ..., si, sf):
+    where a law continues the run (laws.py)."""
     q0 = np.array(q0, dtype=float)
     p0 = np.array(p0, dtype=float)
     F = model.F
@@ -157,7 +197,8 @@ def run_linear(
     while not done:  # back in Python every LOOP_BUDGET events: Ctrl-C works
         n = K.continue_kernel(
             *consts, model.restitution, model.rank, float(t_end), int(max_impacts),
-            float(log2_floor), float(chatter_tol), float(decouple_tol), bool(record_states),
+            float(log2_floor), float(chatter_tol), float(decouple_tol), float(window),
+            bool(record_states),
             out_i, out_f, out_s, info, *loop, LOOP_BUDGET,
         )  # fmt: skip
         done = n >= 0
@@ -182,8 +223,9 @@ def run_linear(
     dtn = of[:, K.F_DTN]
     with np.errstate(divide="ignore"):
         log2_dt = np.where(dtn > 0, np.log2(np.where(dtn > 0, dtn, 1.0)), -np.inf) + oi[:, K.I_DTE]
-    msg = _message(status, reason, info, of, n, int(info[2]))
-    return LinearRun(
+    t_stop = of[n - 1, K.F_THI] + of[n - 1, K.F_TLO] if n else 0.0
+    msg = run_message(status, reason, t_stop, int(info[2]), (int(info[3]), int(info[4])))
+    run = LinearRun(
         model=model,
         status=status,
         reason=reason,
@@ -204,15 +246,18 @@ def run_linear(
         energy_post=np.ldexp(of[:, K.F_EPOST], 2 * kv),
         log2_energy=of[:, K.F_LOG2E].copy(),
         wall_time_s=wall,
+        simultaneity_window=float(window),
         **states,
     )
+    return run, loop
 
 
-def _message(status: Status, reason: int, info, of, n: int, n_imp: int) -> str:
-    t = of[n - 1, K.F_THI] + of[n - 1, K.F_TLO] if n else 0.0
+def run_message(status: Status, reason: int, t: float, n_imp: int, pair=(-1, -1)) -> str:
+    """The message of a run that stopped at t with `status` and `reason` (REASON_*),
+    after n_imp impacts; `pair`: the two contacts of an undecidable event."""
     what = _REASONS.get(reason, "")
     if status is Status.SIMULTANEOUS_IMPACT:
-        return f"undecidable at t = {t:.17g}: {what} (contacts {int(info[3])} and {int(info[4])})"
+        return f"undecidable at t = {t:.17g}: {what} (contacts {pair[0]} and {pair[1]})"
     if status is Status.SINGULARITY:
         return f"{what} at t = {t:.17g} after {n_imp} impacts"
     if status is Status.MAX_IMPACTS:
@@ -252,7 +297,9 @@ def simulate_linear(
     energy fell below `energy_floor` of its initial value (t_singularity extrapolated
     from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
     max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
-    listed in stats["accumulations"], not as impacts."""
+    listed in stats["accumulations"], not as impacts.  The scene's `impact_law` and
+    `simultaneity_window` apply (laws.py; docs/architecture.md, "The linear model under
+    the laws")."""
     from ..checks import check_linear_options, run_horizon
     from ..scenes import as_scene
     from .exponent_estimates import extrapolate_time_to_go
@@ -270,6 +317,8 @@ def simulate_linear(
         max_impacts=scene.run.max_impacts,
         energy_floor=energy_floor,
         chatter_tol=chatter_tol,
+        impact_law=scene.impact_law,
+        simultaneity_window=scene.simultaneity_window,
     )
     exit_at = first_exit(run)
     if exit_at is not None:  # beyond the small tilts the model holds for (domain.py)
@@ -380,8 +429,8 @@ def trajectory_from_run(
         phases=phases,
         stats=stats,
         t_lo=lo_all,
-        impact_law="paper",  # the linear kernel applies the paper's rule only (so far)
-        simultaneity_window=0.0,
+        impact_law=run.impact_law,
+        simultaneity_window=run.simultaneity_window,
     )
 
 
@@ -394,6 +443,8 @@ def run_linear_exponent(
     g: float = 1.0,
     max_impacts: int = 20000,
     energy_floor: float = 1e-24,
+    impact_law: str = "paper",
+    simultaneity_window: float = 0.0,
 ) -> dict:
     """One run of the paper's exponent study (section 4.3): the n-gon (a = m = 1) from
     (q0, p0) with gravity g until the singularity, an undecidable impact or
@@ -403,7 +454,9 @@ def run_linear_exponent(
     runs, as in the paper, or fewer than 6 decades of energy in the fit window),
     c_stderr, t_singularity (None unless the singularity was reached), n_impacts, and
     the cross-check estimates c_decades (durations of energy decades, no t_f needed) and
-    c_period (ratios over one period of a periodic impact pattern, when there is one)."""
+    c_period (ratios over one period of a periodic impact pattern, when there is one).
+    `impact_law`, `simultaneity_window`: as for `run_linear` (under `paper` an
+    undecidable run has no c, as in the paper)."""
     from .exponent_estimates import exponent_of_run
 
     base = {
@@ -428,6 +481,8 @@ def run_linear_exponent(
         energy_floor=energy_floor,
         chatter_tol=math.inf,
         record_states=False,
+        impact_law=impact_law,
+        simultaneity_window=simultaneity_window,
     )
     out = dict(base)
     out.update(
