@@ -65,11 +65,13 @@ MAX_ROTATION_VECTOR = 1e3
 # the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
 IMPACT_LAWS = ("paper", "moreau", "sequential")
 DEFAULT_IMPACT_LAW = "paper"
-# the simultaneity window [time unit of the scene]: contacts whose zeros are this close
-# are reached together; 0 = strictly sequential (the core orders contacts down to its
-# time resolution).  1e-11: far above the event times' certified error (~1e-16 t), far
-# below the steps engines resolve (1e-4), and the largest decade that leaves the check
-# scenes' cascades alone (docs/architecture.md, "Impact laws", measured)
+# the exact reference's simultaneity window [time unit of the scene] when neither the
+# scene nor the options set one: contacts whose zeros are this close are reached
+# together; 0 = strictly sequential (the core orders contacts down to its time
+# resolution).  1e-11: far above the event times' certified error (~1e-16 t), far below
+# the steps engines resolve (1e-4), and the largest decade that leaves the check scenes'
+# cascades alone (docs/architecture.md, "Impact laws", measured).  The linear model's
+# default is 0 (reference.linear.simulate.LINEAR_DEFAULT_WINDOW)
 DEFAULT_SIMULTANEITY_WINDOW = 1e-11
 SCALE_RANGE = (1e-50, 1e50)
 MAX_IMPACTS = 10_000_000
@@ -160,7 +162,7 @@ class Scene:
     description: str = ""
     run: RunSettings = field(default_factory=RunSettings)
     impact_law: str = DEFAULT_IMPACT_LAW
-    simultaneity_window: float = DEFAULT_SIMULTANEITY_WINDOW
+    simultaneity_window: float | None = None  # None: the simulator's default
 
     @property
     def contacts(self) -> GroundContacts:
@@ -339,10 +341,10 @@ def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
         initial=_parse_initial(_table("initial", data)),
         run=_parse_run(_optional_table("run", data)),
         impact_law=check_impact_law(data.get("impact_law", DEFAULT_IMPACT_LAW)),
-        simultaneity_window=check_window(
-            _number(
-                "simultaneity_window", data.get("simultaneity_window", DEFAULT_SIMULTANEITY_WINDOW)
-            )
+        simultaneity_window=(
+            None
+            if data.get("simultaneity_window") is None
+            else check_window(_number("simultaneity_window", data["simultaneity_window"]))
         ),
     )
     check_scene(scene)

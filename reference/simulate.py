@@ -32,7 +32,13 @@ from .core.records import (
 from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
-from .scene import Scene, check_impact_law, check_window, scene_from_dict
+from .scene import (
+    DEFAULT_SIMULTANEITY_WINDOW,
+    Scene,
+    check_impact_law,
+    check_window,
+    scene_from_dict,
+)
 from .stats import RunStats
 from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
 
@@ -246,12 +252,11 @@ def simulate(
 
 def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
     """The impact law and simultaneity window of a run: the options' if set, else the
-    scene's."""
+    scene's, else (the window) DEFAULT_SIMULTANEITY_WINDOW."""
     law = opts.impact_law if opts.impact_law is not None else scene.impact_law
-    window = (
-        opts.simultaneity_window
-        if opts.simultaneity_window is not None
-        else scene.simultaneity_window
+    window = next(
+        (w for w in (opts.simultaneity_window, scene.simultaneity_window) if w is not None),
+        DEFAULT_SIMULTANEITY_WINDOW,
     )
     return check_impact_law(law), check_window(window)
 

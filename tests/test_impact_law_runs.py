@@ -107,6 +107,7 @@ def test_the_sequential_law_resolves_a_flat_landing_without_gaining_energy():
 def test_the_scene_key_and_its_checks():
     base = {"body": {"n": 3}, "initial": {"q": [0.01, 0, 0.02], "p": [0, 0, 0]}}
     assert scene_from_dict(base).impact_law == "paper"
+    assert scene_from_dict(base).simultaneity_window is None  # the simulator's default
     assert scene_from_dict({**base, "impact_law": "sequential"}).impact_law == "sequential"
     with pytest.raises(SceneError, match="impact_law must be one of"):
         scene_from_dict({**base, "impact_law": "stronge"})
@@ -156,7 +157,7 @@ def test_a_start_just_above_the_ground_is_one_simultaneous_impact_within_the_win
     y_up = y.copy()
     y_up[2] += 1e-12
     lifted = make_scene(n=n, gamma=scene.restitution, state=y_up, t_end=0.5)
-    assert lifted.simultaneity_window == DEFAULT_SIMULTANEITY_WINDOW > 0
+    assert lifted.simultaneity_window is None and DEFAULT_SIMULTANEITY_WINDOW > 0
     on_ground = simulate(scene, options=ReferenceOptions(impact_law="moreau"))
     above = simulate(lifted, options=ReferenceOptions(impact_law="moreau"))
     first = [e for e in on_ground.impacts if e.t == 0.0]
