@@ -50,6 +50,7 @@ def main() -> None:
     a, b, k = args.restitution.split(":")
     gammas = np.linspace(float(a), float(b), int(k))
     for law in args.laws.split(","):
+        all_c, n_all, n_singular = [], 0, 0
         for ig, gamma in enumerate(gammas):
             cs, statuses = [], []
             for s in range(args.samples):
@@ -65,11 +66,15 @@ def main() -> None:
                     if fit.c is not None:
                         cs.append(fit.c)
             n_sing = statuses.count("singularity")
+            all_c, n_all, n_singular = all_c + cs, n_all + len(statuses), n_singular + n_sing
             mean = f"{statistics.mean(cs):.3f}" if cs else "-"
             std = f"{statistics.stdev(cs):.3f}" if len(cs) > 1 else "-"
             print(f"{law:10s} gamma={gamma:.2f} singularity {n_sing}/{len(statuses)} "
                   f"with c {len(cs)}/{n_sing}  c = {mean} ± {std}  "
                   f"statuses={sorted(set(statuses))}", flush=True)  # fmt: skip
+        mean = f"{statistics.mean(all_c):.3f}" if all_c else "-"
+        print(f"{law:10s} all        singularity {n_singular}/{n_all} "
+              f"with c {len(all_c)}/{n_singular}  mean c = {mean}", flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":
