@@ -119,3 +119,24 @@ def test_the_three_point_ground_gives_the_exponent_two(gamma, law):
     assert fit.fit_decades >= 6
     assert fit.c == pytest.approx(2.0, abs=0.05)
     assert math.isfinite(fit.c_stderr)
+
+
+def test_an_elastic_disk_sliding_off_the_bumps_does_not_end_at_the_singularity():
+    """γ = 1 keeps the energy, so the motion has no end: the tumbling disk slides off
+    the bumps (`left_model`).  On its way its centre passes beyond the bumps' triangle,
+    where the excess (the energy of the tilt and the height) is negative; that is not
+    an exhausted energy."""
+    from reference.scene import scene_from_dict
+
+    scene = scene_from_dict(
+        {
+            "restitution": 1.0,
+            "body": {"n": 3, "gyration": 0.45},
+            "ground": {"kind": "three_point", "bump_radius": 0.5},
+            "initial": {"q": [0.012, -0.007, 0.05], "p": [0.2, -0.15, -0.5]},
+            "run": {"t_end": 1e4, "max_impacts": 20_000},
+        }
+    )
+    traj = simulate(scene)
+    assert traj.status.value == "left_model"
+    assert excess_energy_of(traj, scene).min() < 0

@@ -270,7 +270,7 @@ def _loop(run: _Run, y: np.ndarray, max_impacts: int):
             t = run.clock.hi
             t_f = t if run.laid_down_at is None else run.laid_down_at
             return Status.SINGULARITY, f"all contacts down at t = {t:.17g}", t_f
-        if E0 > 0 and excess_energy(model, y) <= run.opts.energy_floor * E0:
+        if E0 > 0 and abs(excess_energy(model, y)) <= run.opts.energy_floor * E0:
             t_f = _extrapolate_singularity(run)
             return (
                 Status.SINGULARITY,
