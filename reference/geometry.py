@@ -86,10 +86,12 @@ def energies(scene: Scene, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def excess_energy(scene: Scene, states: np.ndarray) -> np.ndarray:
-    """(N,) energy above the lowest level the ground's invariants allow (the level the
-    motion ends at: rim vertices on the plane E − ½ m |v_h|² − L_z²/(2 I3), floor points
-    on the face E − ½ I3 ω3², `GroundContacts.invariants`): the E of
-    the paper's E ≈ a (t_f − t)^c, which goes to zero at the end of the motion."""
+    """(N,) energy above the level the motion ends at (`inertia.excess_energy`, by the
+    ground's `GroundContacts.invariants`): rim vertices on the plane
+    E − ½ m |v_h|² − L_z²/(2 I3); floor points on the face E − ½ m |v_h|² − ½ I3 ω3²
+    (ω3 is kept and the flat disk slides freely on the bumps), the energy of the tilt and
+    the height: the E of the paper's E ≈ a (t_f − t)^c, which goes to zero at the end of
+    the motion."""
     return _energy_rows(scene, states)[:, 2]
 
 

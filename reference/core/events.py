@@ -24,6 +24,7 @@ from .records import (
     STATUS_OFF_FACE,
     STATUS_PUSHED,
     STATUS_SIMULTANEOUS,
+    STATUS_SINGULARITY,
 )
 
 
@@ -111,6 +112,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
             if vn > vnoise:
                 stats.max_completion_u_rel = max(stats.max_completion_u_rel, vn / vs)
     u = out_imp.u_post
+    t_completed = -1.0  # accumulation time of the chatter completed here (none: < 0)
     if u <= vnoise and bounce_ratio(model.gamma) == 0.0:  # a plastic contact stays
         ws.cand[m] = k
         m += 1
@@ -119,12 +121,19 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
         if completes:
             stats.chatter_completions += 1
             stats.max_completion_u_rel = max(stats.max_completion_u_rel, u / vs)
-            push_accumulation(out, accumulation_time(state.t_hi, u, a_n, model.gamma))
+            t_completed = accumulation_time(state.t_hi, u, a_n, model.gamma)
+            push_accumulation(out, t_completed)
             ws.cand[m] = k
             m += 1
     if not hold(state, model, pts, ws, ws.cand, m):
         return False
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    if t_completed >= 0.0 and state.n_active >= model.all_down:
+        # the completed chatter lays the body down: the motion ends at rest at its
+        # accumulation time, not at the impact that began it
+        end_run(state, STATUS_SINGULARITY, state.active, min(state.n_active, 3))
+        state.t_singularity = t_completed
+        return False
     return True
 
 

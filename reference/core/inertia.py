@@ -97,16 +97,26 @@ def potential_energy(y, mass, gravity):
 
 @hot
 def excess_energy(y, invariants, mass, i1, i3, gravity):
-    """Energy above the lowest level the ground's invariants allow (the body flat on the
-    ground; `invariants`: records.KEEPS_* bits): the horizontal momentum and L_z kept
-    (vertical contact forces), E − ½ m |v_h|² − L_z²/(2 I3); the spin ω3 kept (forces
-    along e3), E − ½ I3 ω3²; neither, E."""
-    e = kinetic_energy(y, mass, i1, i3) + potential_energy(y, mass, gravity)
+    """Energy above the level the motion ends at (the body flat on the ground;
+    `invariants`: records.KEEPS_* bits):
+
+    - vertical contact forces (rim vertices on the plane) keep the horizontal momentum
+      and L_z: E − ½ m |v_h|² − L_z²/(2 I3);
+    - forces along e3 (floor points on the face) keep the spin ω3, and the body flat on
+      the floor points slides on them freely (its face is level and frictionless), so
+      the motion ends flat with whatever horizontal velocity it has then: the level is
+      ½ m |v_h|² + ½ I3 ω3² and the excess is the energy of the tilt and the height,
+      ½ m v_z² + ½ I1 |ω − ω3 e3|² + m g z (the paper's three-bump model, §4: its q and
+      p are the tilt, the height and their rates), summed without cancellation;
+    - neither: E."""
     e3x, e3y, e3z = body_axis(y)
     w3 = y[WX] * e3x + y[WY] * e3y + y[WZ] * e3z
+    if invariants & KEEPS_SPIN:
+        px, py, pz = y[WX] - w3 * e3x, y[WY] - w3 * e3y, y[WZ] - w3 * e3z
+        tilting = 0.5 * i1 * (px * px + py * py + pz * pz)
+        return 0.5 * mass * y[VZ] * y[VZ] + tilting + potential_energy(y, mass, gravity)
+    e = kinetic_energy(y, mass, i1, i3) + potential_energy(y, mass, gravity)
     if invariants & KEEPS_PLANE_MOMENTA:
         lz = i1 * y[WZ] + (i3 - i1) * w3 * e3z
         e = e - 0.5 * mass * (y[VX] ** 2 + y[VY] ** 2) - lz * lz / (2.0 * i3)
-    if invariants & KEEPS_SPIN:
-        e = e - 0.5 * i3 * w3 * w3
     return e

@@ -124,7 +124,9 @@ def _motion_ended(state, model, opts, out):
     y = state.y
     if state.excess0 > 0:
         e = excess_energy(y, model.invariants, model.mass, model.i1, model.i3, model.gravity)
-        if e <= opts.energy_floor * state.excess0:
+        # |e|: a negative excess (three-point ground, the centre beyond the bumps'
+        # triangle, where the disk has no rest) is not an exhausted one
+        if abs(e) <= opts.energy_floor * state.excess0:
             end_run(state, STATUS_ENERGY_EXHAUSTED, none, 0)
             state.t_singularity = extrapolate_singularity(out, state.t_hi)
             return True

@@ -159,6 +159,9 @@ class _Run:
     phases: list[Phase] = field(default_factory=list)
     stats: dict = field(default_factory=dict)
     max_impacts: int = 100_000
+    # the accumulation time of a chatter whose completion laid the body down (the motion
+    # ends there, not at the impact that began it); None otherwise
+    laid_down_at: float | None = None
 
     def sample(self, y: np.ndarray, s: float = 0.0) -> None:
         """Record state y at local time s after the clock."""
@@ -174,7 +177,8 @@ class _Run:
 
 def excess_energy(model: BodyModel, y: np.ndarray) -> float:
     """Energy above the lowest level the invariants allow (body flat on the ground):
-    flat ground: E − ½ m |v_h|² − L_z² / (2 I3); three_point: E − ½ I3 ω3²; bumpy:
+    flat ground: E − ½ m |v_h|² − L_z² / (2 I3); three_point: E − ½ m |v_h|² − ½ I3 ω3²
+    (ω3 is kept, and the flat body slides freely on the bumps); bumpy:
     E − ½ I3 ω3² − m g z_rest (z_rest: the centre lying flat on the bumps; ω3 is
     conserved once only the bumps push)."""
     E = model.energy(y)
@@ -186,7 +190,8 @@ def excess_energy(model: BodyModel, y: np.ndarray) -> float:
         Lz = float(model.angular_momentum(y)[2])
         return E - 0.5 * model.mass * (v[0] ** 2 + v[1] ** 2) - Lz * Lz / (2 * model.i3)
     w3 = float(y[W] @ qt.body_axis(y[Q]))
-    return E - 0.5 * model.i3 * w3 * w3
+    v = y[V]
+    return E - 0.5 * model.mass * (v[0] ** 2 + v[1] ** 2) - 0.5 * model.i3 * w3 * w3
 
 
 def simulate(
@@ -263,8 +268,9 @@ def _loop(run: _Run, y: np.ndarray, max_impacts: int):
             return Status.MAX_IMPACTS, f"reached max_impacts = {max_impacts}", None
         if _all_down(model, active):
             t = run.clock.hi
-            return Status.SINGULARITY, f"all contacts down at t = {t:.17g}", t
-        if E0 > 0 and excess_energy(model, y) <= run.opts.energy_floor * E0:
+            t_f = t if run.laid_down_at is None else run.laid_down_at
+            return Status.SINGULARITY, f"all contacts down at t = {t:.17g}", t_f
+        if E0 > 0 and abs(excess_energy(model, y)) <= run.opts.energy_floor * E0:
             t_f = _extrapolate_singularity(run)
             return (
                 Status.SINGULARITY,
@@ -554,6 +560,7 @@ def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
     # (two-point chatter: the body rocks between two contacts with shrinking speeds)
     candidates = [j for j in resting if res.others_post[j] <= small]
     u = res.u_post
+    t_acc = None  # accumulation time of a chatter completed here
     if u <= vnoise and run.gamma == 0.0:
         candidates.append(k)
     elif u <= small:
@@ -576,5 +583,6 @@ def _resolve(run: _Run, y: np.ndarray, hitting: list[int], resting: list[int]):
         active, _ = solve_contact_lcp(model, y, candidates)
     else:
         active = []
+    run.laid_down_at = t_acc if t_acc is not None and _all_down(model, active) else None
     run.sample(y)
     return y, active
