@@ -570,6 +570,14 @@ def check_not_below_ground(scene: Scene) -> None:
         )
     if len(scene.contacts.floor_points) and body_axis(y0[QUATERNION])[2] <= 0.0:
         raise SceneError(f"{scene.ground.kind} ground needs the body's face normal pointing up")
+    depth = scene.ground.floor_below(scene.body)
+    e3 = body_axis(y0[QUATERNION])
+    rim = y0[2] + depth - scene.body.radius * math.hypot(e3[0], e3[1])
+    if rim < -1e-12 * scene.body.radius:
+        raise SceneError(
+            f"the body starts below the floor plane z = {-depth:g} (ground.floor_depth under "
+            f"the bumps): its rim is {-rim:.3g} below it"
+        )
 
 
 # What a missing required table must give (a message says what to write, docs/contract.md).
