@@ -12,7 +12,8 @@ phases and chatter, n = 1000 γ = 1 with the vertex windows, the three-point gro
 impacts: `left_model`; before that limit it left the bumps after 10), fast spin n = 16
 γ = 1 and n = 100 γ = 0.5 (the circle step and the rim descent)).  Each run's impacts
 (t, t_lo, contact, impulse, normal velocities), phases, status, final time and
-t_singularity are written as the hex of their doubles, so `compare` is exact.  Only the public API is used.
+t_singularity are written as the hex of their doubles, so `compare` is exact.  Only the
+public API is used.
 """
 
 from __future__ import annotations
