@@ -116,7 +116,7 @@ def test_the_small_bump_probe_ends_left_model_where_the_oracle_crosses_the_floor
     t, h = oracle.t[i - 2 : i + 2], H[i - 2 : i + 2]
     roots = np.roots(np.polyfit(t - t[1], h, 3)) + t[1]
     t_floor = min(r.real for r in roots if abs(r.imag) < 1e-12 and t[1] <= r.real <= t[2])
-    assert traj.t_final == pytest.approx(t_floor, abs=1e-8)
+    assert traj.t_final == pytest.approx(t_floor, abs=1e-10)  # (measured: 4e-13)
     assert len(traj.impacts) == len(oracle.impacts)
 
 
