@@ -59,6 +59,11 @@ DIMENSION_RANGE = (1e-50, 1e50)
 GYRATION_RANGE = (1e-6, 1e6)
 MAX_VERTICES = 1_000_000
 MIN_BUMP_RADIUS = 1e-6
+# three_point ground: the floor plane lies this far below the bumps' tops, in body radii,
+# unless [ground] floor_depth says (a model limit, not a contact: reference.core.floor).
+# A tenth of the radius: a disk held on a bump at b = a/2 reaches it at a tilt of about
+# 0.2 rad, where the linear model leaves its domain (reference.linear.domain).
+DEFAULT_FLOOR_DEPTH = 0.1
 MAX_SPEED = 1e3
 MAX_POSITION = 1e6
 MAX_ROTATION_VECTOR = 1e3
@@ -101,6 +106,9 @@ class Ground:
     touch the body's face; `bumpy` (issue 32), both: the plane under the rim and bumps
     above it under the face, `bumps` (x, y, height) or three at (b cos 2πk/3,
     b sin 2πk/3, bump_height).  Lengths in the scene's units, like the body's radius.
+    On `three_point` ground the floor plane lies `floor_depth` below the bumps' tops
+    (None: DEFAULT_FLOOR_DEPTH body radii; inf: no floor): not a contact, a model limit
+    (`floor_below`).
     `contacts` turns it into the list of contacts of kinds (reference.contact_kinds)
     that everything else reads."""
 
@@ -108,6 +116,18 @@ class Ground:
     bump_radius: float = 0.5
     bump_height: float = 0.0
     bumps: tuple[tuple[float, float, float], ...] | None = None
+    floor_depth: float | None = None
+
+    def floor_below(self, body: Body) -> float:
+        """d of the floor plane z = −d under the `three_point` ground's bumps (tops at
+        z = 0), which that ground does not model: its rim reaching the plane ends a run
+        `left_model` (reference.core.floor).  inf on the grounds whose rim vertices have
+        the plane z = 0 as contacts (`flat`, `bumpy`), and on request."""
+        if self.kind != "three_point":
+            return math.inf
+        if self.floor_depth is None:
+            return DEFAULT_FLOOR_DEPTH * body.radius
+        return self.floor_depth
 
     def bump_table(self) -> tuple[tuple[float, float, float], ...]:
         """(x, y, height) of every bump of a bumpy ground (module docstring)."""
@@ -239,7 +259,7 @@ _TOP_KEYS = {
     "body", "ground", "initial", "run",
 }  # fmt: skip
 _BODY_KEYS = {"n", "radius", "mass", "gyration"}
-_GROUND_KEYS = {"kind", "bump_radius", "bump_height", "bumps"}
+_GROUND_KEYS = {"kind", "bump_radius", "bump_height", "bumps", "floor_depth"}
 GROUND_KINDS = ("flat", "three_point", "bumpy")
 # Most bumps a bumpy ground may list (each is a contact the search examines one by one).
 MAX_BUMPS = 64
@@ -389,6 +409,11 @@ def _parse_ground(gr: dict, body: Body) -> Ground:
         raise SceneError(f"ground.kind must be 'flat', 'three_point' or 'bumpy', got {kind!r}")
     if kind != "bumpy" and ("bump_height" in gr or "bumps" in gr):
         raise SceneError("ground.bump_height and ground.bumps belong to kind = 'bumpy'")
+    if kind != "three_point" and "floor_depth" in gr:
+        raise SceneError(
+            "ground.floor_depth belongs to kind = 'three_point' (the other grounds have the "
+            "plane z = 0 as the rim's contacts)"
+        )
     if kind == "bumpy" and "bumps" in gr:
         if "bump_radius" in gr or "bump_height" in gr:
             raise SceneError(
@@ -408,7 +433,24 @@ def _parse_ground(gr: dict, body: Body) -> Ground:
         height = _number("ground.bump_height", gr.get("bump_height", 0.0))
         _check_bump_height("ground.bump_height", height, body.radius)
         return Ground(kind=kind, bump_radius=bump, bump_height=height)
+    if kind == "three_point" and "floor_depth" in gr:
+        depth = _floor_depth(gr["floor_depth"], body.radius)
+        return Ground(kind=kind, bump_radius=bump, floor_depth=depth)
     return Ground(kind=kind, bump_radius=bump)
+
+
+def _floor_depth(value: Any, radius: float) -> float:
+    """ground.floor_depth: how far below the bumps' tops the floor plane lies, in
+    (0, MAX_POSITION] × body.radius, or inf (no floor)."""
+    if isinstance(value, float) and value == math.inf:
+        return value
+    d = _number("ground.floor_depth", value)
+    if not 0.0 < d <= MAX_POSITION * radius:
+        raise SceneError(
+            f"ground.floor_depth must be in (0, {MAX_POSITION:g}] x body.radius "
+            f"({radius:g}) or inf, got {d:g}"
+        )
+    return d
 
 
 def _parse_bumps(value: Any, radius: float) -> tuple[tuple[float, float, float], ...]:
@@ -534,6 +576,14 @@ def check_not_below_ground(scene: Scene) -> None:
         )
     if len(scene.contacts.floor_points) and body_axis(y0[QUATERNION])[2] <= 0.0:
         raise SceneError(f"{scene.ground.kind} ground needs the body's face normal pointing up")
+    depth = scene.ground.floor_below(scene.body)
+    e3 = body_axis(y0[QUATERNION])
+    rim = y0[2] + depth - scene.body.radius * math.hypot(e3[0], e3[1])
+    if rim < -1e-12 * scene.body.radius:
+        raise SceneError(
+            f"the body starts below the floor plane z = {-depth:g} (ground.floor_depth under "
+            f"the bumps): its rim is {-rim:.3g} below it"
+        )
 
 
 # What a missing required table must give (a message says what to write, docs/contract.md).

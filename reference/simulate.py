@@ -144,6 +144,7 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["sag"] = 1.0 - math.cos(math.pi / scene.body.n)
     rec["all_down"] = contacts.all_down
     rec["window"] = scene.simultaneity_window
+    rec["floor_depth"] = scene.ground.floor_below(scene.body)
     return rec
 
 
@@ -313,60 +314,72 @@ _STATUS = {
     R.STATUS_PUSHED: Status.SIMULTANEOUS_IMPACT,
     R.STATUS_MAX_IMPACTS: Status.MAX_IMPACTS,
     R.STATUS_OFF_FACE: Status.LEFT_MODEL,
+    R.STATUS_BELOW_FLOOR: Status.LEFT_MODEL,
 }
 
 
-# One-sentence messages per loop status: (state, options, t, sorted info contacts) →
-# text, formatted only for the status a run ends with.
+# One-sentence messages per loop status: (state, options, model, t, sorted info
+# contacts) → text, formatted only for the status a run ends with.
 _MESSAGES = {
-    R.STATUS_T_END: lambda st, op, t, cs: f"reached t_end = {float(op['t_end']):g}",
-    R.STATUS_SINGULARITY: lambda st, op, t, cs: f"all contacts down at t = {t:.17g}",
-    R.STATUS_ENERGY_EXHAUSTED: lambda st, op, t, cs: (
+    R.STATUS_T_END: lambda st, op, md, t, cs: f"reached t_end = {float(op['t_end']):g}",
+    R.STATUS_SINGULARITY: lambda st, op, md, t, cs: f"all contacts down at t = {t:.17g}",
+    R.STATUS_ENERGY_EXHAUSTED: lambda st, op, md, t, cs: (
         f"energy exhausted to {float(op['energy_floor']):g} of its initial excess; "
         "t_singularity extrapolated from the impact intervals"
     ),
-    R.STATUS_TILT_FLOOR: lambda st, op, t, cs: (
+    R.STATUS_TILT_FLOOR: lambda st, op, md, t, cs: (
         f"inclination below {TILT_FLOOR:g} rad at t = {t:.17g}: the singularity for "
         "double precision; t_singularity extrapolated from the impact intervals"
     ),
-    R.STATUS_AT_REST: lambda st, op, t, cs: (
+    R.STATUS_AT_REST: lambda st, op, md, t, cs: (
         f"at rest on contacts {cs} at t = {t:.17g}: the motion has ended"
     ),
-    R.STATUS_SIMULTANEOUS: lambda st, op, t, cs: (
+    R.STATUS_SIMULTANEOUS: lambda st, op, md, t, cs: (
         f"contacts {cs} hit simultaneously at t = {t:.17g}"
     ),
-    R.STATUS_PUSHED: lambda st, op, t, cs: (
+    R.STATUS_PUSHED: lambda st, op, md, t, cs: (
         f"impact at contact {int(st['info_contact'])} at t = {t:.17g} would push "
         f"resting contact(s) {cs} into the ground (undecidable)"
     ),
-    R.STATUS_MAX_IMPACTS: lambda st, op, t, cs: f"reached max_impacts = {int(op['max_impacts'])}",
-    R.STATUS_FAILED_NONFINITE: lambda st, op, t, cs: f"non-finite state at t = {t:.17g}",
-    R.STATUS_OFF_FACE: lambda st, op, t, cs: (
+    R.STATUS_MAX_IMPACTS: lambda st, op, md, t, cs: (
+        f"reached max_impacts = {int(op['max_impacts'])}"
+    ),
+    R.STATUS_FAILED_NONFINITE: lambda st, op, md, t, cs: f"non-finite state at t = {t:.17g}",
+    R.STATUS_OFF_FACE: lambda st, op, md, t, cs: (
         f"bump {cs[0] if cs else -1} meets the face's plane outside its rim "
         f"at t = {t:.17g}: the body has left the bumps (outside the three_point model)"
     ),
-    R.STATUS_FAILED_LCP: lambda st, op, t, cs: (
+    R.STATUS_BELOW_FLOOR: lambda st, op, md, t, cs: (
+        f"the rim reached the floor plane z = {-float(md['floor_depth']):g} (floor_depth "
+        f"below the bumps' tops) at t = {t:.17g}, which the three_point ground does not "
+        "model: the body has left the model"
+    ),
+    R.STATUS_FAILED_LCP: lambda st, op, md, t, cs: (
         f"contact complementarity problem of contacts {cs} has no solution (at t = {t:.17g})"
     ),
-    R.STATUS_FAILED_STUCK: lambda st, op, t, cs: f"event search did not converge (at t = {t:.17g})",
-    R.STATUS_FAILED_INTEGRATION: lambda st, op, t, cs: (
+    R.STATUS_FAILED_STUCK: lambda st, op, md, t, cs: (
+        f"event search did not converge (at t = {t:.17g})"
+    ),
+    R.STATUS_FAILED_INTEGRATION: lambda st, op, md, t, cs: (
         f"contact integration failed: step size below roundoff (at t = {t:.17g})"
     ),
-    R.STATUS_FAILED_NO_ADVANCE: lambda st, op, t, cs: (
+    R.STATUS_FAILED_NO_ADVANCE: lambda st, op, md, t, cs: (
         f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, or "
         f"{MAX_STALL_STEPS} steps without progress, with contacts {cs} held)"
     ),
 }
 
 
-def status_message(state: np.void, opts: np.void) -> tuple[Status, str]:
-    """The Trajectory status and its one-sentence message for the loop's end state."""
+def status_message(state: np.void, opts: np.void, model: np.void) -> tuple[Status, str]:
+    """The Trajectory status and its one-sentence message for the loop's end state (the
+    run's options and model records)."""
     code = int(state["status"])
     message = _MESSAGES.get(code)
     if message is None:
         return _STATUS.get(code, Status.FAILED), f"loop status {code}"
     contacts = sorted(int(c) for c in state["info"][: int(state["n_info"])])
-    return _STATUS.get(code, Status.FAILED), message(state, opts, float(state["info_t"]), contacts)
+    t = float(state["info_t"])
+    return _STATUS.get(code, Status.FAILED), message(state, opts, model, t, contacts)
 
 
 def _trajectory(
@@ -380,7 +393,7 @@ def _trajectory(
         )
     ns, ni, nph, nacc = (int(c[i]) for i in (N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS))
     state = p.state[0]
-    status, message = status_message(state, p.options[0])
+    status, message = status_message(state, p.options[0], p.model[0])
     t_sing = float(state["t_singularity"])
     stats = RunStats.from_counters(
         p.counters[0],

@@ -18,12 +18,14 @@ def make_scene(
     ground="flat",
     bump=0.5,
     bump_height=0.0,
+    floor_depth=None,
     t_end=3.0,
     max_impacts=100_000,
     state=None,
     name="test",
 ) -> Scene:
-    """A scene from linear coordinates (q, p) or from a full 13-state `state`."""
+    """A scene from linear coordinates (q, p) or from a full 13-state `state`
+    (floor_depth: the three_point ground's floor, None for its default)."""
     if state is not None:
         y = np.asarray(state, dtype=float)
         initial = InitialState(
@@ -34,7 +36,9 @@ def make_scene(
     return Scene(
         name=name,
         body=Body(n=n, gyration=rho),
-        ground=Ground(kind=ground, bump_radius=bump, bump_height=bump_height),
+        ground=Ground(
+            kind=ground, bump_radius=bump, bump_height=bump_height, floor_depth=floor_depth
+        ),
         initial=initial,
         restitution=gamma,
         gravity=1.0,

@@ -74,7 +74,7 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
     core maps to its Trajectory status (written out here, not read from simulate) with
     a message of its own; an unknown code is `failed` with `loop status N`."""
     from reference.core import records as R
-    from reference.simulate import initial_record, options_record, status_message
+    from reference.simulate import initial_record, model_record, options_record, status_message
     from reference.trajectory import Status
 
     expected = {
@@ -87,6 +87,7 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
         "PUSHED": Status.SIMULTANEOUS_IMPACT,
         "MAX_IMPACTS": Status.MAX_IMPACTS,
         "OFF_FACE": Status.LEFT_MODEL,
+        "BELOW_FLOOR": Status.LEFT_MODEL,
         "FAILED_NONFINITE": Status.FAILED,
         "FAILED_LCP": Status.FAILED,
         "FAILED_STUCK": Status.FAILED,
@@ -96,6 +97,7 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
 
     scene = resolve_scene("rod")
     opts = options_record(scene, 1.0, ReferenceOptions())[0]
+    model = model_record(scene)[0]
     state = initial_record(np.zeros(13))[0]
     state["info_t"], state["n_info"] = 0.125, 1
     state["info"][0] = 2
@@ -106,12 +108,12 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
     messages = set()
     for name, code in codes.items():
         state["status"] = code
-        status, message = status_message(state, opts)
+        status, message = status_message(state, opts, model)
         assert status == expected[name], name
         assert message and not message.startswith("loop status")
         messages.add(message)
     assert len(messages) == len(codes)
     state["status"] = R.STATUS_SIMULTANEOUS
-    assert status_message(state, opts)[1] == "contacts [2] hit simultaneously at t = 0.125"
+    assert status_message(state, opts, model)[1] == "contacts [2] hit simultaneously at t = 0.125"
     state["status"] = 999
-    assert status_message(state, opts) == (Status.FAILED, "loop status 999")
+    assert status_message(state, opts, model) == (Status.FAILED, "loop status 999")

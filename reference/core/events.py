@@ -13,6 +13,7 @@ from .contacts import (
     rate_noise,
     velocity_scale,
 )
+from .floor import below_floor
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
@@ -20,6 +21,7 @@ from .jit import copy_into, hot
 from .output import push_accumulation, push_impact, push_sample
 from .records import (
     STATUS_AT_REST,
+    STATUS_BELOW_FLOOR,
     STATUS_FAILED_LCP,
     STATUS_OFF_FACE,
     STATUS_PUSHED,
@@ -198,12 +200,17 @@ def _same_set(a, na, b, nb):
 def start(state, model, pts, opts, stats, out, ws, cs):
     """The run's first step: sample the initial state, then resolve contacts touching at
     t = 0 (hitting: an impact with the resting ones held; resting only: hold them).
+    A state below the floor plane of a ground without rim contacts ends `left_model`.
     A body with every contact resting is already at the end of its motion."""
     y = state.y
     state.excess0 = excess_energy(
         y, model.invariants, model.mass, model.i1, model.i3, model.gravity
     )
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    if below_floor(y, model):  # (a state given below the floor plane: reference.core.floor)
+        state.started = True
+        end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
+        return False
     vnoise = rate_noise(y, model.radius)
     n_hit = n_rest = 0
     hitting, resting = cs.hitting, cs.together

@@ -11,7 +11,9 @@ explicit status and never guesses:
   of its initial value, or the tilt below TILT_FLOOR, end it at the singularity, with
   t_singularity (extrapolated from the geometric sequence of the last impact
   intervals);
-- a bump outside the face on the three-point ground ends it `left_model`;
+- a bump outside the face on the three-point ground ends it `left_model`, and so does
+  its rim reaching the floor plane under the bumps, which that ground does not model
+  (reference.core.floor: located in flight and in contact phases, or at the start);
 - a loop that stops advancing (MAX_STALL_STEPS steps at one time) ends it as failed.
 
 Time is a double-double and every phase runs in its own local time, so intervals near

@@ -20,6 +20,7 @@ from .contacts import (
     length_scale,
     rate_noise,
     reached_together,
+    rim_jet,
     time_resolution,
     velocity_scale,
 )
@@ -33,6 +34,7 @@ from .dop853 import (
 )
 from .events import activate, end_run, hold, resolve_impact
 from .flight import flight_constants, free_flight
+from .floor import below_floor, floor_gap, floor_horizon, floor_reach, has_floor
 from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
@@ -46,13 +48,16 @@ from .records import (
     N_SAMPLES,
     PHASE_CONTACT,
     PHASE_FLIGHT,
+    STATUS_BELOW_FLOOR,
     STATUS_FAILED_INTEGRATION,
     STATUS_FAILED_NO_ADVANCE,
     STATUS_FAILED_STUCK,
 )
 from .search import flight_event
 from .tolerances import (
+    BRACKET_ITERATIONS,
     CONTACT_GAP_RES,
+    EPS,
     HEUN_STEP_RATIO,
     MAX_SEARCH_ITERATIONS,
     TINY,
@@ -108,7 +113,9 @@ def _needed(n_grid, out, opts):
 
 @hot
 def flight_step(state, model, pts, opts, stats, out, ws, cs):
-    """Free flight from the state to its first event (or to t_end), then the event."""
+    """Free flight from the state to its first event (or to t_end), then the event; the
+    rim reaching the floor plane first (a ground without rim contacts, `floor.floor_reach`)
+    ends the run there, `left_model`."""
     y = state.y
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
     fc = flight_constants(y, model.i1, model.i3)
@@ -119,22 +126,30 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     if ev.kind == EVENT_STUCK:
         end_run(state, STATUS_FAILED_STUCK, cs.together, 0)
         return DONE
-    n_grid = grid_count(state.t_hi, state.t_lo, ev.s, opts.sample_dt)
+    s_floor = floor_reach(y, fc, model, ev.s)
+    s_end = ev.s
+    if s_floor >= 0.0:
+        s_end = s_floor
+        free_flight(y, fc, model.gravity, s_end, ws.y_event)
+    n_grid = grid_count(state.t_hi, state.t_lo, s_end, opts.sample_dt)
     if _needed(n_grid, out, opts):
         return NEEDS_ROWS
     stats.flight_searches += 1
     stats.search_iterations += ev.iterations
-    k, dt, n = grid_times(state.t_hi, state.t_lo, ev.s, opts.sample_dt, n_grid + 1)
+    k, dt, n = grid_times(state.t_hi, state.t_lo, s_end, opts.sample_dt, n_grid + 1)
     for i in range(n):
         s = grid_time(k + i, dt, state.t_hi, state.t_lo)
         free_flight(y, fc, model.gravity, s, ws.y_chunk)
         hi, lo = two_sum_add(state.t_hi, state.t_lo, s)
         push_sample(out, hi, lo, ws.y_chunk, model, opts.max_samples)
     t0 = state.t_hi
-    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, ev.s)
+    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_end)
     copy_into(y, ws.y_event)
     push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    if s_floor >= 0.0:
+        end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
+        return DONE
     if ev.kind == EVENT_NONE:
         return DONE
     if ev.kind == EVENT_ACTIVATION:
@@ -368,6 +383,8 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     h, _ = certified_horizon(state, model, pts, acc, cs, ex, min(remaining, t_near))
     if state.has_trend:
         h = force_trend_limit(h, ws.lam_chunk, state.lam_prev, state.h_prev, m)
+    if has_floor(model):
+        h = floor_horizon(y, acc, rim_jet(y, acc, model.radius), model, ex.K, h)
     if h <= 0:
         close_contact_phase(state, model, stats, out)
         if remaining > 0:
@@ -389,25 +406,81 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
         h_start, True,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
+    return _chunk_outcome(state, model, pts, opts, stats, out, ws, cs, r, h, ns0, remaining)
+
+
+@hot
+def _chunk_outcome(state, model, pts, opts, stats, out, ws, cs, r, h, ns0, remaining):
+    """What an integrated chunk of length h (its integration r, ws.y_chunk its end)
+    leads to: a failure, a lift-off, the rim below the floor plane (before any of the
+    chunk's other outcomes: `_floor_in_chunk`), a free contact crossed or reached (its
+    impact next), or the chunk's end."""
+    m = state.n_active
     if r.status == INT_FAILED:
         end_run(state, STATUS_FAILED_INTEGRATION, state.active, m)
         return DONE
     if r.status != INT_CROSSING:  # a crossing stays where its gap is zero: the impact's state
         project_held(ws.y_chunk, model, pts, state.active, m, ws)
-    if r.status == INT_LIFT_OFF:
+    lift_off = r.status == INT_LIFT_OFF
+    if lift_off and not below_floor(ws.y_chunk, model):
         return _lift_off(state, model, pts, opts, stats, out, ws, r)
-    n_crossed = _crossed(ws.y_chunk, state, model, pts, opts, cs, gap_res)
+    s_end = r.s
+    n_crossed = 0 if lift_off else _crossed(ws.y_chunk, state, model, pts, opts, cs, state.gap_res)
     if n_crossed:
         stats.horizon_backstops += 1
-        s_star = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, r.s, n_crossed)
-        _drop_samples_after(out, ns0, state, s_star)
-        if two_sum_add(state.t_hi, state.t_lo, s_star)[0] == state.t_hi:
-            return _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed)
-        return _cut_chunk(state, ws, s_star)
+        s_end = _locate_crossing(state, model, pts, opts, stats, out, ws, cs, r.s, n_crossed)
+    if below_floor(ws.y_chunk, model):  # before the chunk's end, its lift-off or crossing
+        return _floor_in_chunk(state, model, pts, opts, stats, out, ws, cs, s_end, ns0)
+    if n_crossed:
+        _drop_samples_after(out, ns0, state, s_end)
+        if two_sum_add(state.t_hi, state.t_lo, s_end)[0] == state.t_hi:
+            return _touching_now(state, model, pts, opts, stats, out, ws, cs, s_end, n_crossed)
+        return _cut_chunk(state, ws, s_end)
     if r.status == INT_CROSSING:  # an approaching contact reached the ground: its impact next
         stats.contact_chunks += 1
         return _cut_chunk(state, ws, r.s)
     return _end_chunk(state, model, opts, stats, out, ws, h, r.h_next, remaining)
+
+
+@hot
+def _integrate_to(state, model, pts, opts, stats, out, ws, cs, s):
+    """ws.y_chunk: the held motion integrated from the chunk's start ws.y_start over s,
+    projected, without samples or watched contacts."""
+    copy_into(ws.y_chunk, ws.y_start)
+    r = integrate_held(
+        ws.y_chunk, s, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
+        ws, ws, (0, 1.0, 0), out, (state.t_hi, state.t_lo), opts.max_samples, False,
+        cs.together, 0,
+    )  # fmt: skip
+    stats.contact_rhs_evals += r.nfev
+    project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
+
+
+@hot
+def _floor_in_chunk(state, model, pts, opts, stats, out, ws, cs, h, ns0):
+    """The chunk of length h ended with the rim below the floor plane (`floor.below_floor`):
+    the first time it reached the plane, bisected on the chunk integrated again from its
+    start (H = `floor.floor_gap` ≤ 0 at the bracket's right end) until the bracket is
+    within two ulps of its end; the run ends there `left_model`, the chunk cut and its
+    later samples dropped.  Bisection, not Newton: H along the integrated motion is
+    known to the integrator's tolerance, and this runs once per run."""
+    lo, hi = 0.0, h
+    for _ in range(BRACKET_ITERATIONS):
+        mid = 0.5 * (lo + hi)
+        if not (lo < mid < hi) or hi - lo <= 2.0 * EPS * hi:
+            break
+        _integrate_to(state, model, pts, opts, stats, out, ws, cs, mid)
+        if floor_gap(ws.y_chunk, model) > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    _integrate_to(state, model, pts, opts, stats, out, ws, cs, hi)
+    _drop_samples_after(out, ns0, state, hi)
+    _cut_chunk(state, ws, hi)
+    push_sample(out, state.t_hi, state.t_lo, state.y, model, opts.max_samples)
+    close_contact_phase(state, model, stats, out)
+    end_run(state, STATUS_BELOW_FLOOR, state.active, 0)
+    return DONE
 
 
 @hot
@@ -454,6 +527,8 @@ def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near,
     if not err <= 1.0 or _negative_force(ws.lam_chunk, m) or _negative_force(ws.lam, m):
         return False
     if _crossed(ws.y_chunk, state, model, pts, opts, cs, state.gap_res):
+        return False
+    if below_floor(ws.y_chunk, model):  # (the DOP853 chunk locates it)
         return False
     if n_near:
         stats.contact_chunks += 1

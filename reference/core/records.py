@@ -66,6 +66,8 @@ MODEL = np.dtype(
         # lowest point, per a sin α, when that point is midway between two vertices
         ("all_down", np.int64),  # contacts held together that end the motion
         ("window", np.float64),  # simultaneity window: zeros this close are reached together
+        ("floor_depth", np.float64),  # d: the floor plane z = −d, a model limit of a ground
+        # without rim vertices (reference.core.floor); inf: none
     ]
 )
 
@@ -129,6 +131,7 @@ STATUS_FAILED_NO_ADVANCE = 10  # a contact phase cannot advance before t_end
 STATUS_AT_REST = 11  # singularity at the start: all contacts down and at rest
 STATUS_TILT_FLOOR = 12  # singularity: tilt below TILT_FLOOR after impacts
 STATUS_OFF_FACE = 13  # a floor point outside the face's rim (contacts.off_face): left the bumps
+STATUS_BELOW_FLOOR = 14  # the rim reached the floor plane of a ground without rim contacts
 
 # Counters of a run (reference.stats.RunStats reads them by name).
 STATS = np.dtype(
