@@ -27,8 +27,9 @@ class ReferenceOptions:
       paper's rule: the run ends `simultaneous_impact`), `moreau` or `sequential`
       (reference.core.impact_laws; docs/architecture.md, "Impact laws"); None: the
       scene's `impact_law` (default `paper`).
-    simultaneity_window: contacts reaching the ground within this time of each other
-      count as one simultaneous impact; None: the scene's (default 1e-11; 0: strictly
+    simultaneity_window: contacts reaching the ground within this time T of each other
+      count as one simultaneous impact (T |u|/√(g a) after a contact reached at normal
+      speed |u|: scene.window_speed_unit); None: the scene's, else 1e-11 (0: strictly
       sequential).
     sequential_order: the `sequential` law's order of contacts (sweeps over it); None:
       the fastest approaching first.

@@ -522,6 +522,24 @@ def check_scene(scene: Scene) -> None:
     check_not_below_ground(scene)
 
 
+def reference_window(scene: Scene) -> float:
+    """The exact reference's simultaneity window T for the scene: its own, else
+    DEFAULT_SIMULTANEITY_WINDOW (zeros within T |u|/U of a contact reached at speed |u|
+    are reached together, U = velocity_unit)."""
+    w = scene.simultaneity_window
+    return DEFAULT_SIMULTANEITY_WINDOW if w is None else w
+
+
+def window_speed_unit(scene: Scene) -> float:
+    """V = √(g a), the speed whose contacts the simultaneity window T is stated for: a
+    contact reached at normal speed |u| takes those whose zeros lie within T |u|/V
+    (T |u|/V = (T √(g/a)) · |u|/g, a fixed fraction of the time |u|/g of its own bounce:
+    the window scales with the motion, so a cascade's late impacts, whose intervals
+    shrink with the speeds, are never merged).  Without gravity: velocity_unit."""
+    g, a = scene.gravity, scene.body.radius
+    return math.sqrt(g * a) if g > 0 else velocity_unit(scene)
+
+
 def velocity_unit(scene: Scene) -> float:
     """U = a/τ = max(√(g a), a/t_end): the speed unit of the speed group."""
     a = scene.body.radius

@@ -33,11 +33,12 @@ from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
 from .geometry import contact_points, initial_state
 from .options import ReferenceOptions
 from .scene import (
-    DEFAULT_SIMULTANEITY_WINDOW,
     Scene,
     check_impact_law,
     check_window,
+    reference_window,
     scene_from_dict,
+    window_speed_unit,
 )
 from .stats import RunStats
 from .trajectory import ImpactLog, PhaseLog, Status, Trajectory
@@ -143,7 +144,7 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["invariants"] = contacts.invariants
     rec["sag"] = 1.0 - math.cos(math.pi / scene.body.n)
     rec["all_down"] = contacts.all_down
-    rec["window"] = scene.simultaneity_window
+    rec["window_per_speed"] = reference_window(scene) / window_speed_unit(scene)
     rec["floor_depth"] = scene.ground.floor_below(scene.body)
     return rec
 
@@ -253,11 +254,12 @@ def simulate(
 
 def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
     """The impact law and simultaneity window of a run: the options' if set, else the
-    scene's, else (the window) DEFAULT_SIMULTANEITY_WINDOW."""
+    scene's, else (the window) the reference's default (scene.reference_window)."""
     law = opts.impact_law if opts.impact_law is not None else scene.impact_law
-    window = next(
-        (w for w in (opts.simultaneity_window, scene.simultaneity_window) if w is not None),
-        DEFAULT_SIMULTANEITY_WINDOW,
+    window = (
+        opts.simultaneity_window
+        if opts.simultaneity_window is not None
+        else reference_window(scene)
     )
     return check_impact_law(law), check_window(window)
 

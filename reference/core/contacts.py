@@ -236,11 +236,15 @@ def time_resolution(noise, rate):
 
 
 @hot
-def reached_together(gap, rate, noise, tres0, window):
+def reached_together(gap, rate, noise, tres0, rate0, window_per_speed):
     """Whether a contact approaching (rate < 0) reaches the ground together with one
-    reached now whose time resolution is tres0: its zero, gap/|rate| away, is within
-    SIMULTANEOUS_FACTOR × the sum of their time resolutions (the model cannot order
-    them) plus the simultaneity window (model.window; 0: strictly sequential)."""
+    reached now at normal velocity rate0 whose time resolution is tres0: its zero,
+    gap/|rate| away, is within SIMULTANEOUS_FACTOR × the sum of their time resolutions
+    (the model cannot order them) plus the simultaneity window on the motion's scale,
+    T |rate0|/U (model.window_per_speed = T/U, U the scene's velocity unit; T = 0:
+    strictly sequential).  Scaled by the speed, the window keeps apart the late impacts
+    of a cascade, whose intervals shrink with the speeds (docs/architecture.md)."""
+    window = window_per_speed * abs(rate0)
     return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0) + window
 
 

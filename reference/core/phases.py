@@ -215,7 +215,9 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
             cs.together[n_land] = cs.cand[i]
             n_land += 1
     if n_hit:
-        n_hit = _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, model.window)
+        n_hit = _add_reached_together(
+            cs, n_cand, first, n_hit, vnoise, gap_res, model.window_per_speed
+        )
         close_contact_phase(state, model, stats, out)
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
@@ -231,7 +233,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
 
 
 @hot
-def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, window):
+def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, window_per_speed):
     """Append to cs.hitting the approaching contacts above their roundoff that are
     `reached_together` with the touching cs.cand[first], each gap known to
     max(its roundoff, gap_res) (the integrator's resolution of positions in a contact
@@ -240,7 +242,9 @@ def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, window):
     for i in range(n_cand):
         if cs.gap[i] > cs.noise[i] and cs.rate[i] < -vnoise:
             gap_i = max(cs.noise[i], gap_res)
-            if reached_together(cs.gap[i], cs.rate[i], gap_i, tres0, window):
+            if reached_together(
+                cs.gap[i], cs.rate[i], gap_i, tres0, cs.rate[first], window_per_speed
+            ):
                 cs.hitting[n_hit] = cs.cand[i]
                 n_hit += 1
     return n_hit

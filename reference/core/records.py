@@ -65,7 +65,9 @@ MODEL = np.dtype(
         ("sag", np.float64),  # 1 − cos(π/n): how far a vertex sits above the circle's
         # lowest point, per a sin α, when that point is midway between two vertices
         ("all_down", np.int64),  # contacts held together that end the motion
-        ("window", np.float64),  # simultaneity window: zeros this close are reached together
+        # simultaneity window per unit approach speed, T/U (U: the scene's velocity unit):
+        # zeros within T |u|/U of a contact reached at speed |u| are reached together
+        ("window_per_speed", np.float64),
         ("floor_depth", np.float64),  # d: the floor plane z = −d, a model limit of a ground
         # without rim vertices (reference.core.floor); inf: none
     ]

@@ -385,7 +385,7 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
         f, rate = frame_and_rate(y, cols, kind_in_ground(n_rim, k), pts, k)
         if rate >= -vnoise:
             continue
-        if reached_together(f.gap, rate, f.noise, tres0, model.window):
+        if reached_together(f.gap, rate, f.noise, tres0, rate0, model.window_per_speed):
             together[count] = k
             count += 1
     return count
