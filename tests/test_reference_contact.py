@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from reference import ReferenceOptions
 from reference import quaternion as qt
 from reference.core.contacts import vertex_lever
 from reference.core.held import held_forces, new_work
@@ -121,10 +122,17 @@ def test_contact_phase_keeps_energy_and_constraints():
 def test_gamma_zero_heavy_rim_triangle_reaches_the_singularity():
     """Regression (sweep at ρ = 1, γ = 0): a contact force that is already pulling at a
     chunk start, or crosses zero only in the projected end state, is a lift-off, not a
-    root-finding failure.  The run must end in a decided state with energy exhausted."""
+    root-finding failure.  The run must end in a decided state with energy exhausted.
+    Strictly sequential (window 0): at t = 2.7377 the edge 1-2 lands with its vertices
+    1.3e-13 apart at 0.12 and 0.09, which the default window makes one simultaneous
+    impact (the paper's rule then ends the run there: checked too)."""
     q = (-0.0004465939407552824, 0.000480321018228262, 1.0)
     p = (-0.03882222191615614, 0.03983622205983048, -1.0)
-    traj = simulate(make_scene(n=3, rho=1.0, gamma=0.0, q=q, p=p, t_end=200.0))
+    scene = make_scene(n=3, rho=1.0, gamma=0.0, q=q, p=p, t_end=200.0)
+    windowed = simulate(scene)
+    assert windowed.status.value == "simultaneous_impact"
+    assert windowed.t_final == pytest.approx(2.7377035679316, abs=1e-12)
+    traj = simulate(scene, options=ReferenceOptions(simultaneity_window=0.0))
     assert traj.status.value == "singularity"
     assert traj.t_singularity is not None and traj.t_singularity > traj.impacts[-1].t - 1e-9
 
