@@ -156,8 +156,8 @@ def phase_gap_res(y, model, opts):
 @hot
 def begin_contact_phase(state, model, opts):
     """Enter a contact phase with the held contacts: its start, energy and gap
-    resolution (`phase_gap_res` at the start; `_end_chunk` raises it to the largest
-    length scale the phase's positions have had)."""
+    resolution (`phase_gap_res` at the start; from the first chunk's end when it
+    starts exactly flat, `_end_chunk`)."""
     y = state.y
     state.in_contact = True
     state.phase_t0 = state.t_hi
@@ -425,18 +425,21 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
 @hot
 def _end_chunk(state, model, opts, stats, out, ws, h, h_next, remaining):
     """Advance to the end of a chunk of length h (state ws.y_chunk, projected): its
-    forces at the start give the next chunk their trend, h_next its first step.  The
-    phase's gap resolution becomes at least `phase_gap_res` here: the positions were
-    integrated to that tolerance.  A phase that begins with L = 0 (a body exactly flat
-    at z = 0 after a simultaneous impact, one vertex leaving beside a held edge) would
-    otherwise keep a resolution of 0: when the vertex comes back, its gap and the gap's
-    roundoff (∝ |z| + |r_z|) shrink together, no chunk ever finds it touching, and the
-    chunks shrink geometrically at one time (the phase "cannot advance")."""
+    forces at the start give the next chunk their trend, h_next its first step.  A
+    phase that began with L = 0 (a body exactly flat at z = 0 after a simultaneous
+    impact, one vertex leaving beside a held edge) takes its gap resolution here, from
+    the first chunk's end (`phase_gap_res`: the positions were integrated on that
+    scale); with a resolution of 0, when the vertex came back its gap and the gap's
+    roundoff (∝ |z| + |r_z|) shrank together, no chunk found it touching, and the
+    chunks shrank geometrically at one time (the phase "cannot advance").  A phase with
+    L > 0 keeps its start's resolution: raised as L grows, contacts were reached
+    together that the paper's rule resolves one by one."""
     y = state.y
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
     copy_into(y, ws.y_chunk)
-    state.gap_res = max(state.gap_res, phase_gap_res(y, model, opts))
+    if state.gap_res == 0.0:
+        state.gap_res = phase_gap_res(y, model, opts)
     for i in range(state.n_active):  # the next chunk sees the forces' trend
         state.lam_prev[i] = ws.lam_chunk[i]
     state.h_prev = h
