@@ -96,3 +96,29 @@ def test_safe_step_is_the_first_root_of_the_larger_bound_from_below(seed):
             assert capped >= cap
         elif want <= cap * (1 - 2 * ROOT_REL_TOL):
             assert want * (1 - ROOT_REL_TOL) <= capped <= want * (1 + 1e-12)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_gap_exactly_zero_and_rising_is_safe_until_its_bounds_come_back(seed):
+    """A gap exactly 0 leaving the ground (g′ > 0: a vertex leaving a body that lies
+    exactly flat at z = 0, its roundoff 0 too) is positive until the later of the
+    bounds' second roots: P2 = δ(g′ − Kδ/2) at 2g′/K and P3 = δ(g′ + g″δ/2 − Bδ²/6) at
+    the positive root of its quadratic factor (B = 0: the Taylor quadratic's).  A gap
+    exactly 0 and not rising, or below 0, gives 0."""
+    rng = np.random.default_rng(seed)
+    for _ in range(500):
+        g1 = 10.0 ** rng.uniform(-6, 1)
+        g2 = rng.normal() * 10.0 ** rng.uniform(-2, 1)
+        K = abs(g2) * (1.0 + 10.0 ** rng.uniform(-3, 1))
+        B = 0.0 if rng.random() < 0.5 else 10.0 ** rng.uniform(-1, 3)
+        p3_roots = np.roots([-B / 6.0, 0.5 * g2, g1]) if B > 0 else np.roots([0.5 * g2, g1])
+        p3 = min((r.real for r in p3_roots if abs(r.imag) == 0 and r.real > 0), default=math.inf)
+        want = max(2.0 * g1 / K, p3)
+        got = safe_step(0.0, g1, g2, K, B)
+        if not math.isfinite(want):
+            assert got == math.inf
+            continue
+        assert want * (1 - 2 * ROOT_REL_TOL) <= got <= want * (1 + 1e-12), (g1, g2, K, B)
+        assert safe_step(0.0, -g1, g2, K, B) == 0.0
+        assert safe_step(0.0, 0.0, g2, K, B) == 0.0
+        assert safe_step(-1e-300, g1, g2, K, B) == 0.0

@@ -162,14 +162,21 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
 
 
 @hot
+def phase_gap_res(y, model, opts):
+    """The gap resolution of a contact phase at state y: the integrator's tolerance on
+    the positions, CONTACT_GAP_RES × rtol × the length scale L = |z| + a sin α."""
+    return CONTACT_GAP_RES * opts.contact_rtol * length_scale(y, model.radius)
+
+
+@hot
 def begin_contact_phase(state, model, opts):
     """Enter a contact phase with the held contacts: its start, energy and gap
-    resolution (roundoff, or the integrator's tolerance on the positions:
-    CONTACT_GAP_RES × rtol × the phase's length scale)."""
+    resolution (`phase_gap_res` at the start; from the first chunk's end when it
+    starts exactly flat, `_end_chunk`)."""
     y = state.y
     state.in_contact = True
     state.phase_t0 = state.t_hi
-    state.gap_res = CONTACT_GAP_RES * opts.contact_rtol * length_scale(y, model.radius)
+    state.gap_res = phase_gap_res(y, model, opts)
     state.phase_energy0 = kinetic_energy(y, model.mass, model.i1, model.i3) + potential_energy(
         y, model.mass, model.gravity
     )
@@ -265,10 +272,15 @@ def _set_tolerances(y, model, scale_x, rtol, atol):
 
 
 @hot
-def _chunk_tolerances(y, model, opts, atol):
+def _chunk_tolerances(y, model, opts, atol, h):
     """A chunk's absolute tolerances (`_set_tolerances`, positions on the length scale L
-    of state y); returns L."""
+    of state y; a chunk of length h from a body exactly flat at z = 0, L = 0, on the
+    extent U h its positions may reach, as `_first_step`: on rtol × TINY, a denormal,
+    the roundoff of components that stay near zero, e.g. q_z without spin, was an error
+    above tolerance at every step size, and the chunk never ended); returns the scale."""
     L = length_scale(y, model.radius)
+    if L == 0.0:
+        L = length_rate(y, model.radius) * h
     _set_tolerances(y, model, L, opts.contact_rtol, atol)
     return L
 
@@ -282,7 +294,7 @@ def _prepare_chunk(state, model, pts, opts, stats, ws, h):
         L = length_scale(state.y, model.radius)
         h_start, nfev = _first_step(state, model, pts, opts, ws, h, L)
         stats.contact_rhs_evals += nfev
-    _chunk_tolerances(state.y, model, opts, ws.atol)
+    _chunk_tolerances(state.y, model, opts, ws.atol, h)
     return h_start
 
 
@@ -490,11 +502,21 @@ def _floor_in_chunk(state, model, pts, opts, stats, out, ws, cs, h, ns0):
 @hot
 def _end_chunk(state, model, opts, stats, out, ws, h, h_next, remaining):
     """Advance to the end of a chunk of length h (state ws.y_chunk, projected): its
-    forces at the start give the next chunk their trend, h_next its first step."""
+    forces at the start give the next chunk their trend, h_next its first step.  A
+    phase that began with L = 0 (a body exactly flat at z = 0 after a simultaneous
+    impact, one vertex leaving beside a held edge) takes its gap resolution here, from
+    the first chunk's end (`phase_gap_res`: the positions were integrated on that
+    scale); with a resolution of 0, when the vertex came back its gap and the gap's
+    roundoff (∝ |z| + |r_z|) shrank together, no chunk found it touching, and the
+    chunks shrank geometrically at one time (the phase "cannot advance").  A phase with
+    L > 0 keeps its start's resolution: raised as L grows, contacts were reached
+    together that the paper's rule resolves one by one."""
     y = state.y
     stats.contact_chunks += 1
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, h)
     copy_into(y, ws.y_chunk)
+    if state.gap_res == 0.0:
+        state.gap_res = phase_gap_res(y, model, opts)
     for i in range(state.n_active):  # the next chunk sees the forces' trend
         state.lam_prev[i] = ws.lam_chunk[i]
     state.h_prev = h
@@ -523,7 +545,7 @@ def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near,
     if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0 or _needed(0, out, opts):
         return False
     y, m = state.y, state.n_active
-    _chunk_tolerances(y, model, opts, ws.atol)
+    _chunk_tolerances(y, model, opts, ws.atol, s)
     err = heun_euler_step(y, ws.f, s, opts.contact_rtol, ws.atol, model, pts, state.active, m,
                           ws, ws, ws.y_chunk)  # fmt: skip
     held_forces(ws.y_chunk, model, pts, state.active, m, ws)

@@ -172,12 +172,17 @@ def quadratic_taylor_root(g, g1, g2):
 
 @hot
 def safe_step(g, g1, g2, K, B, cap=math.inf):
-    """First positive root of max(P2, P3): no contact before it; 0 if g ≤ 0.
+    """First positive root of max(P2, P3): no contact before it; 0 if g < 0, or g = 0
+    and the gap not rising (g′ ≤ 0).  A gap exactly zero and rising (a contact leaving
+    the ground from a state where its gap and its roundoff are both exactly zero: a
+    body lying exactly flat at z = 0 with one vertex leaving beside two held ones, after
+    a simultaneous impact) is positive until P2's second root 2g′/K (P2 = δ(g′ − Kδ/2)):
+    returning 0 there stalled the contact phase.
 
     When P2's root is already ≥ `cap` (the smallest step found so far among other
     contacts), or P3 stays positive up to `cap`, this contact does not bind the step and
     P3 is not solved: a value ≥ cap is returned."""
-    if g <= 0.0:
+    if g < 0.0 or (g == 0.0 and not g1 > 0.0):
         return 0.0
     if cap < math.inf and p2_positive_at(g, g1, K, cap):
         return cap  # P2's root is past cap
