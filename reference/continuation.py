@@ -172,8 +172,9 @@ def continue_run(
     same_time, last_t = 0, None
     while undecidable(st[0]):
         t_hi, t_lo = float(st["t_hi"][0]), float(st["t_lo"][0])
-        same_time = same_time + 1 if t_hi == last_t else 0
-        last_t = t_hi
+        # the time is a double-double: a cascade below one ulp of t advances in t_lo
+        same_time = same_time + 1 if (t_hi, t_lo) == last_t else 0
+        last_t = (t_hi, t_lo)
         if same_time >= MAX_RESTARTS_AT_ONE_TIME:
             return f"the {law} law made no progress at t = {t_hi:.17g}: stopped (undecidable)"
         y = np.array(st["y"][0], dtype=float)

@@ -29,8 +29,9 @@ class ReferenceOptions:
       scene's `impact_law` (default `paper`).
     simultaneity_window: contacts reaching the ground within this time T of each other
       count as one simultaneous impact (T |u|/√(g a) after a contact reached at normal
-      speed |u|: scene.window_speed_unit); None: the scene's, else 1e-11 (0: strictly
-      sequential).
+      speed |u|: scene.window_speed_unit); None: the scene's, else the law's
+      (scene.default_window: 1e-11 under moreau and sequential, 0 under paper; 0:
+      strictly sequential).
     sequential_order: the `sequential` law's order of contacts (sweeps over it); None:
       the fastest approaching first.
     """

@@ -70,8 +70,9 @@ MAX_ROTATION_VECTOR = 1e3
 # the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
 IMPACT_LAWS = ("paper", "moreau", "sequential")
 DEFAULT_IMPACT_LAW = "paper"
-# the exact reference's simultaneity window [time unit of the scene] when neither the
-# scene nor the options set one: contacts whose zeros are this close are reached
+# the exact reference's simultaneity window [time unit of the scene] under `moreau` and
+# `sequential` when neither the scene nor the options set one (under `paper`: 0,
+# default_window): contacts whose zeros are this close (× |u|/√(g a)) are reached
 # together; 0 = strictly sequential (the core orders contacts down to its time
 # resolution).  1e-11: far above the event times' certified error (~1e-16 t), far below
 # the steps engines resolve (1e-4), and the largest decade that leaves the check scenes'
@@ -522,12 +523,20 @@ def check_scene(scene: Scene) -> None:
     check_not_below_ground(scene)
 
 
-def reference_window(scene: Scene) -> float:
-    """The exact reference's simultaneity window T for the scene: its own, else
-    DEFAULT_SIMULTANEITY_WINDOW (zeros within T |u|/U of a contact reached at speed |u|
-    are reached together, U = velocity_unit)."""
+def reference_window(scene: Scene, law: str | None = None) -> float:
+    """The exact reference's simultaneity window T for the scene under `law` (None: the
+    scene's): its own, else default_window(law) (zeros within T |u|/V of a contact
+    reached at speed |u| are reached together, V = window_speed_unit)."""
     w = scene.simultaneity_window
-    return DEFAULT_SIMULTANEITY_WINDOW if w is None else w
+    return default_window(law or scene.impact_law) if w is None else w
+
+
+def default_window(law: str) -> float:
+    """The reference's default window under `law`: 0 under `paper` (the paper's rule
+    and its results as they are: a window there ends more runs `simultaneous_impact`,
+    measured in docs/architecture.md), DEFAULT_SIMULTANEITY_WINDOW under the laws that
+    resolve a simultaneous impact."""
+    return 0.0 if law == "paper" else DEFAULT_SIMULTANEITY_WINDOW
 
 
 def window_speed_unit(scene: Scene) -> float:

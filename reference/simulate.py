@@ -254,12 +254,12 @@ def simulate(
 
 def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
     """The impact law and simultaneity window of a run: the options' if set, else the
-    scene's, else (the window) the reference's default (scene.reference_window)."""
+    scene's, else (the window) the law's default (scene.reference_window)."""
     law = opts.impact_law if opts.impact_law is not None else scene.impact_law
     window = (
         opts.simultaneity_window
         if opts.simultaneity_window is not None
-        else reference_window(scene)
+        else reference_window(scene, law)
     )
     return check_impact_law(law), check_window(window)
 

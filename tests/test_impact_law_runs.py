@@ -132,7 +132,7 @@ def test_every_output_names_the_law(tmp_path, capsys):
     assert doc["status"] == "singularity" and doc["t_singularity"] == pytest.approx(3.0)
     assert len({r["t"] for r in doc["impacts"]}) == 1 and len(doc["impacts"]) == 6
     assert main(["simulate", str(path)]) == 0
-    assert "impact law  paper (simultaneity window 1e-11)" in capsys.readouterr().out
+    assert "impact law  paper (simultaneity window 0)" in capsys.readouterr().out
     assert main(["simulate", str(path), "--simultaneity-window", "-1"]) == 2
     assert main(["branches", str(path), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
@@ -147,12 +147,13 @@ def test_every_output_names_the_law(tmp_path, capsys):
 
 @pytest.mark.parametrize("case", list(STARTS))
 def test_a_start_just_above_the_ground_is_one_simultaneous_impact_within_the_window(case):
-    """The same states lifted 1e-12 above the ground: with the default window
-    (DEFAULT_SIMULTANEITY_WINDOW) they are one simultaneous impact, `simultaneous_impact`
-    under the paper's rule, and under Moreau's law the impulses of the start on the
-    ground; with the window 0 the contacts are met one by one, picoseconds apart.  (The
-    flat triangle's slowest vertex, at 0.10, has its free-flight zero 8.7e-12 after the
-    first vertex's, reached at 0.88: inside T|u|/√(g a) = 8.8e-12.)"""
+    """The same states lifted 1e-12 above the ground: with the default window of the
+    laws (DEFAULT_SIMULTANEITY_WINDOW) they are one simultaneous impact: under Moreau's
+    law the impulses of the start on the ground, and, given that window, under the
+    paper's rule `simultaneous_impact`; with the window 0 the contacts are met one by
+    one, picoseconds apart.  (The flat triangle's slowest vertex, at 0.10, has its
+    free-flight zero 8.7e-12 after the first vertex's, reached at 0.88: inside
+    T|u|/√(g a) = 8.8e-12.)"""
     n, rot, v, w = STARTS[case]
     scene, y = _on_ground(n, rot, v, w)
     y_up = y.copy()
@@ -167,9 +168,11 @@ def test_a_start_just_above_the_ground_is_one_simultaneous_impact_within_the_win
     assert [e.contact for e in again] == [e.contact for e in first]
     for a, b in zip(again, first, strict=True):
         assert a.impulse == pytest.approx(b.impulse, rel=1e-9)
-    paper = simulate(lifted)
+    windowed = ReferenceOptions(simultaneity_window=DEFAULT_SIMULTANEITY_WINDOW)
+    paper = simulate(lifted, options=windowed)
     assert paper.status.value == "simultaneous_impact"
     assert paper.simultaneity_window == DEFAULT_SIMULTANEITY_WINDOW
+    assert simulate(lifted).simultaneity_window == 0.0  # the paper's default
     strict = simulate(lifted, options=ReferenceOptions(simultaneity_window=0.0))
     assert strict.status.value != "simultaneous_impact"
     t0 = strict.impacts[0].t

@@ -123,16 +123,16 @@ def test_gamma_zero_heavy_rim_triangle_reaches_the_singularity():
     """Regression (sweep at ρ = 1, γ = 0): a contact force that is already pulling at a
     chunk start, or crosses zero only in the projected end state, is a lift-off, not a
     root-finding failure.  The run must end in a decided state with energy exhausted.
-    Strictly sequential (window 0): at t = 2.7377 the edge 1-2 lands with its vertices
-    1.3e-13 apart at 0.12 and 0.09, which the default window makes one simultaneous
-    impact (the paper's rule then ends the run there: checked too)."""
+    Strictly sequential (the paper's default window 0): at t = 2.7377 the edge 1-2 lands
+    with its vertices 1.3e-13 apart at 0.12 and 0.09, which the laws' default window
+    makes one simultaneous impact (the paper's rule then ends the run there: checked)."""
     q = (-0.0004465939407552824, 0.000480321018228262, 1.0)
     p = (-0.03882222191615614, 0.03983622205983048, -1.0)
     scene = make_scene(n=3, rho=1.0, gamma=0.0, q=q, p=p, t_end=200.0)
-    windowed = simulate(scene)
+    windowed = simulate(scene, options=ReferenceOptions(simultaneity_window=1e-11))
     assert windowed.status.value == "simultaneous_impact"
     assert windowed.t_final == pytest.approx(2.7377035679316, abs=1e-12)
-    traj = simulate(scene, options=ReferenceOptions(simultaneity_window=0.0))
+    traj = simulate(scene)
     assert traj.status.value == "singularity"
     assert traj.t_singularity is not None and traj.t_singularity > traj.impacts[-1].t - 1e-9
 

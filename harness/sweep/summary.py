@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+from ..text import impact_law_text
+
 
 def _f(x):
     if x is None:
@@ -85,8 +87,11 @@ def summarise(config, df, store, statuses_now, n_before, n_missing, refused_now=
 def format_summary(doc: dict) -> str:
     g = doc["grid"]
     t = doc["tasks"]
+    law = ""
+    if doc["engine"] in ("reference", "linear"):
+        law = f", impact law {impact_law_text(doc['impact_law'], doc['simultaneity_window'])}"
     lines = [
-        f"exponent sweep: engine {doc['engine']}, n = {doc['n']}, "
+        f"exponent sweep: engine {doc['engine']}{law}, n = {doc['n']}, "
         f"{len(g['restitution'])} γ x {len(g['gyration'])} ρ x {g['samples']} runs, "
         f"seed {g['seed']}",
         f"runs: {t['rows']} of {t['total']} stored ({t['stored_before']} before, "
