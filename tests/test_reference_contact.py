@@ -203,3 +203,30 @@ def test_a_chunk_far_shorter_than_the_integrators_step_is_one_heun_euler_step():
         if code == RETURN_GROW:
             problem.grow(opts.max_samples)
     assert short >= 3
+
+
+def test_a_rod_released_at_rest_on_one_vertex_falls_flat_at_the_energy_equations_time():
+    """A rod (n = 2) at rest, tilted θ0 = 0.3 on vertex 0 (frictionless): the vertex
+    slides, the centre falls straight down (z = a sin θ) and θ̇² = 2g(sin θ0 − sin θ) /
+    (a (cos²θ + ρ²)); vertex 1 lands at T = ∫₀^θ0 dθ/θ̇ (quadrature, independent), where
+    the paper's rule stops (both vertices down).  A start with every velocity exactly 0
+    used to fail at t = 0 ("step size below roundoff")."""
+    from scipy.integrate import quad
+
+    from tests.test_impact_law_runs import _on_ground
+
+    theta0 = 0.3
+    scene, y = _on_ground(2, [0.0, theta0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    traj = simulate(make_scene(n=2, gamma=0.5, state=y, t_end=5.0))
+    a, rho, g = scene.body.radius, scene.body.gyration, scene.gravity
+
+    def dt_dtheta(th):
+        return 1.0 / np.sqrt(
+            2 * g * (np.sin(theta0) - np.sin(th)) / (a * (np.cos(th) ** 2 + rho**2))
+        )
+
+    landing, err = quad(dt_dtheta, 0.0, theta0, limit=200)
+    assert err < 1e-10
+    assert traj.status.value == "simultaneous_impact"
+    assert traj.t_final == pytest.approx(landing, rel=1e-10)
+    assert np.max(np.abs(traj.position[:, 0] - traj.position[0, 0])) < 1e-12  # no push

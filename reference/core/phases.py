@@ -258,11 +258,18 @@ def _add_reached_together(cs, n_cand, first, n_hit, vnoise, gap_res, window_per_
 
 
 @hot
-def _set_tolerances(y, model, scale_x, rtol, atol):
-    """Absolute tolerances of a chunk: rtol × scale_x for positions (over a for the
-    quaternion), rtol × the velocity scale for velocities (over a for ω)."""
+def _set_tolerances(y, model, scale_x, rtol, atol, h):
+    """Absolute tolerances of a chunk of length h: rtol × scale_x for positions (over a
+    for the quaternion), rtol × the velocity scale V for velocities (over a for ω).  A
+    body exactly at rest (V = 0) takes the speed g h gravity gives it over the chunk: on
+    rtol × TINY, a denormal, the roundoff of the velocities that stay near zero was an
+    error above tolerance at every step (a polygon released at rest on one vertex
+    failed at t = 0, "step size below roundoff")."""
     scale_x += TINY
-    scale_v = velocity_scale(y, model.radius) + TINY
+    scale_v = velocity_scale(y, model.radius)
+    if scale_v == 0.0:
+        scale_v = model.gravity * h
+    scale_v += TINY
     for c in range(3):
         atol[c] = rtol * scale_x
         atol[7 + c] = rtol * scale_v
@@ -281,7 +288,7 @@ def _chunk_tolerances(y, model, opts, atol, h):
     L = length_scale(y, model.radius)
     if L == 0.0:
         L = length_rate(y, model.radius) * h
-    _set_tolerances(y, model, L, opts.contact_rtol, atol)
+    _set_tolerances(y, model, L, opts.contact_rtol, atol, h)
     return L
 
 
@@ -306,7 +313,8 @@ def _first_step(state, model, pts, opts, ws, h, L):
     body passing flat while moving, L → 0, would start 1e-20 of the chunk short and take
     dozens of steps to grow.  Returns (h, nfev)."""
     y = state.y
-    _set_tolerances(y, model, L + length_rate(y, model.radius) * h, opts.contact_rtol, ws.atol)
+    scale_x = L + length_rate(y, model.radius) * h
+    _set_tolerances(y, model, scale_x, opts.contact_rtol, ws.atol, h)
     return initial_step(y, ws.f, h, opts.contact_rtol, ws.atol, model, pts, state.active,
                         state.n_active, ws, ws)  # fmt: skip
 
