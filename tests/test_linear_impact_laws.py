@@ -12,6 +12,7 @@ from reference.linear.model import LinearModel, full_states
 from reference.linear.simulate import run_linear, simulate_linear
 from reference.scene import scene_from_dict
 from reference.trajectory import Status
+from tests.oracle.quaternion import to_matrix as oracle_rotation
 
 LAWS = (LAW_MOREAU, LAW_SEQUENTIAL)
 
@@ -41,21 +42,10 @@ def test_one_contact_under_a_law_is_the_kernels_own_impact_bit_for_bit(law):
         assert u_post[0] == pytest.approx(-m.restitution * (F[j] @ p), rel=1e-14, abs=1e-15)
 
 
-def _rotation(quat):
-    w, x, y, z = quat
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def _exact_delassus(n, rho, phi):
     """W = J M⁻¹ Jᵀ of the rigid n-gon (a = m = 1, I = ρ² diag(1, 1, 2)) at rotation
     vector (φx, φy, 0), normals e_z: an independent derivation (not the core's code)."""
-    R = _rotation(full_states(np.array([phi[0], phi[1], 0.0]), np.zeros(3))[0, 3:7])
+    R = oracle_rotation(full_states(np.array([phi[0], phi[1], 0.0]), np.zeros(3))[0, 3:7])
     inv_i = R @ np.diag([1 / rho**2, 1 / rho**2, 1 / (2 * rho**2)]) @ R.T
     ang = 2 * np.pi * np.arange(n) / n
     r = (R @ np.stack([np.cos(ang), np.sin(ang), np.zeros(n)])).T

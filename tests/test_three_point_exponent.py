@@ -14,25 +14,14 @@ from reference.geometry import excess_energy, resting_energy
 from reference.quaternion import from_rotation_vector
 from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear
 from tests.conftest import make_scene
-
-
-def _rotation_matrix(q):
-    """R of the unit quaternion (w, x, y, z), body → world."""
-    w, x, y, z = q
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+from tests.oracle.quaternion import to_matrix as oracle_rotation
 
 
 def _three_point_excess_by_hand(scene, y):
     """E − ½ m |v_h|² − ½ I3 ω3² from the world inertia matrix R diag(I1, I1, I3) Rᵀ."""
     m, g = scene.body.mass, scene.gravity
     i1, _, i3 = scene.body.inertia_diag
-    R = _rotation_matrix(y[3:7])
+    R = oracle_rotation(y[3:7])
     inertia = R @ np.diag([i1, i1, i3]) @ R.T
     v, w = y[7:10], y[10:13]
     energy = 0.5 * m * v @ v + 0.5 * w @ inertia @ w + m * g * y[2]
