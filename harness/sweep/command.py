@@ -66,14 +66,16 @@ def config_from_args(args) -> SweepConfig:
 def sweep_window(args) -> float:
     """The simultaneity window of the reference and the linear model: the option, else
     the simulator's default (the reference's `reference.scene.default_window` of the
-    law, the linear model's 0); 0 (none) for the other engines."""
+    law, the linear model's LINEAR_DEFAULT_WINDOW); 0 (none) for the other engines."""
+    from reference.linear.simulate import LINEAR_DEFAULT_WINDOW
     from reference.scene import default_window
 
     window = getattr(args, "simultaneity_window", None)
     if window is not None:
         return float(window)
-    law = getattr(args, "impact_law", None) or "paper"
-    return default_window(law) if args.engine == "reference" else 0.0
+    if args.engine == "reference":
+        return default_window(getattr(args, "impact_law", None) or "paper")
+    return LINEAR_DEFAULT_WINDOW if args.engine == "linear" else 0.0
 
 
 def takes_window(engine: str) -> bool:
