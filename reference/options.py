@@ -23,10 +23,10 @@ class ReferenceOptions:
     window_search: large polygons (n > 19) examine only the vertices near the ground at
       each search step (False: every vertex; the same events, slower).
     work_budget: loop steps between returns to Python (progress display, Ctrl-C).
-    impact_law: how several contacts touching at an impact are resolved: `paper` (the
-      paper's rule: the run ends `simultaneous_impact`), `moreau` or `sequential`
-      (reference.core.impact_laws; docs/architecture.md, "Impact laws"); None: the
-      scene's `impact_law` (default `paper`).
+    impact_law: how several contacts touching at an impact are resolved: a name of the
+      law registry (reference.core.laws.LAW_NAMES: `paper`, the paper's rule, ends the
+      run `simultaneous_impact`; `moreau`, `sequential`, ...; docs/architecture.md,
+      "Impact laws"); None: the scene's `impact_law` (default `paper`).
     simultaneity_window: contacts reaching the ground within this time T of each other
       count as one simultaneous impact (T |u|/√(g a) after a contact reached at normal
       speed |u|: scene.window_speed_unit); None: the scene's, else the law's

@@ -47,6 +47,7 @@ import numpy as np
 
 from .contact_kinds import GroundContacts, ground_contacts, listed_contacts
 from .core.layout import QUATERNION
+from .core.laws import DEFAULT_LAW, LAW_NAMES, LAW_PAPER, law_code
 from .geometry import initial_state, scene_contact_kinematics
 from .quaternion import body_axis
 
@@ -67,9 +68,9 @@ DEFAULT_FLOOR_DEPTH = 0.1
 MAX_SPEED = 1e3
 MAX_POSITION = 1e6
 MAX_ROTATION_VECTOR = 1e3
-# the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
-IMPACT_LAWS = ("paper", "moreau", "sequential")
-DEFAULT_IMPACT_LAW = "paper"
+# the impact laws of simultaneous impacts: the registry's (reference.core.laws)
+IMPACT_LAWS = LAW_NAMES
+DEFAULT_IMPACT_LAW = DEFAULT_LAW
 # the exact reference's simultaneity window [time unit of the scene] under `moreau` and
 # `sequential` when neither the scene nor the options set one (under `paper`: 0,
 # default_window): contacts whose zeros are this close (× |u|/√(g a)) are reached
@@ -536,7 +537,7 @@ def default_window(law: str) -> float:
     and its results as they are: a window there ends more runs `simultaneous_impact`,
     measured in docs/architecture.md), DEFAULT_SIMULTANEITY_WINDOW under the laws that
     resolve a simultaneous impact."""
-    return 0.0 if law == "paper" else DEFAULT_SIMULTANEITY_WINDOW
+    return 0.0 if law_code(law) == LAW_PAPER else DEFAULT_SIMULTANEITY_WINDOW
 
 
 def window_speed_unit(scene: Scene) -> float:

@@ -32,7 +32,9 @@ def signatures() -> dict:
     i1 = types.Array(types.int64, 1, "C")
     f8, i8, void = types.float64, types.int64, types.void
     return {
-        "run_events": types.int64(rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2),
+        "run_events": types.int64(
+            rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2, f2, f1, i1
+        ),
         "quaternion_product_rows": void(f2, f2, f2),
         "quaternion_exp_rows": void(f2, f2),
         "quaternion_log_rows": void(f2, f2),

@@ -5,16 +5,11 @@ impulses (reference.core.impact_laws), and (v, ω) += M⁻¹JᵀΛ.  Positions a
 
 from .chatter import completion_speed
 from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
-from .impact_laws import (
-    LAW_MOREAU,
-    LAW_SEQUENTIAL,
-    NOT_SETTLED,
-    SETTLED,
-    moreau_impulses,
-    sequential_impulses,
-)
+from .impact_laws import SETTLED
 from .inertia import apply_impulse, impulse_response, response_rate
 from .jit import hot
+from .law_dispatch import solve_law
+from .records import LawWork
 
 
 @hot
@@ -45,9 +40,9 @@ def law_impact(
     y, model, pts, law, contacts, k, order, n_order, max_hits, chatter_tol,
     W, u_pre, lam, u_post, chol, vec, active, result,
 ):  # fmt: skip
-    """In place: the impact of contacts[:k] on state y under `law` (LAW_MOREAU or
-    LAW_SEQUENTIAL; order[:n_order] the sequential law's order, empty: the fastest
-    first), restitution model.gamma.  Fills u_pre, lam, u_post (per contact) and
+    """In place: the impact of contacts[:k] on state y under `law` (a code of
+    reference.core.laws; order[:n_order] the sequential law's order as positions in
+    contacts, empty: the fastest first), restitution model.gamma.  Fills u_pre, lam, u_post (per contact) and
     result[:3] = (status, number of single impacts: 1 for Moreau, 1 if the bounces were
     completed); y changes only when the law settled.
 
@@ -88,15 +83,8 @@ def _solve_law(
     gamma, law, k, order, n_order, max_hits, W, u_pre, lam, u_post, chol, vec, active, result
 ):
     """The law's impulses for restitution gamma: result[:2] = (status, single impacts)."""
-    if law == LAW_MOREAU:
-        status = moreau_impulses(W, u_pre, gamma, k, lam, u_post, chol, vec, active)
-        hits = 1
-    elif law == LAW_SEQUENTIAL:
-        status, hits = sequential_impulses(
-            W, u_pre, gamma, k, order, n_order, lam, u_post, max_hits
-        )
-    else:
-        status, hits = NOT_SETTLED, 0
+    work = LawWork(chol, vec, active, order, n_order, max_hits)
+    status, hits = solve_law(law, W, u_pre, gamma, k, lam, u_post, work)
     result[0], result[1] = status, hits
 
 

@@ -156,7 +156,7 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
         activate(state, model, pts, ws, stats, cs.together, ev.n_together)
         return DONE
     resolve_impact(
-        state, model, pts, opts, stats, out, ws, cs.together, ev.n_together, state.active, 0
+        state, model, pts, opts, stats, out, ws, cs, cs.together, ev.n_together, state.active, 0
     )
     return DONE
 
@@ -229,7 +229,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, hitting, n_hit, ws.held, state.n_active
+            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, ws.held, state.n_active
         )
         return True
     if n_land:
@@ -357,7 +357,8 @@ def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, cs.hitting, n_hit, ws.held, state.n_active
+            state, model, pts, opts, stats, out, ws, cs, cs.hitting, n_hit, ws.held,
+            state.n_active,
         )
         return DONE
     activate(state, model, pts, ws, stats, cs.together, n_crossed)
