@@ -46,8 +46,8 @@ from typing import Any
 import numpy as np
 
 from .contact_kinds import GroundContacts, ground_contacts, listed_contacts
-from .core.layout import QUATERNION
 from .core.laws import DEFAULT_LAW, LAW_NAMES, LAW_PAPER, law_code
+from .core.layout import QUATERNION
 from .geometry import initial_state, scene_contact_kinematics
 from .quaternion import body_axis
 

@@ -1,11 +1,12 @@
-"""The linear model under the exact reference's impact laws (issue 31; reference/linear/laws.py)."""
+"""The linear model under the exact reference's impact laws (reference/linear/laws.py)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from reference.core.impact_laws import LAW_MOREAU, LAW_NAMES, LAW_SEQUENTIAL, SETTLED
+from reference.core.impact_laws import SETTLED
+from reference.core.laws import LAW_NAMES, law_code
 from reference.linear import kernel as K
 from reference.linear.laws import apply_law, delassus
 from reference.linear.model import LinearModel, full_states
@@ -14,6 +15,7 @@ from reference.scene import scene_from_dict
 from reference.trajectory import Status
 from tests.oracle.quaternion import to_matrix as oracle_rotation
 
+LAW_MOREAU, LAW_SEQUENTIAL = law_code("moreau"), law_code("sequential")
 LAWS = (LAW_MOREAU, LAW_SEQUENTIAL)
 
 

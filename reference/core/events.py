@@ -94,9 +94,7 @@ def _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, res
 
 
 @hot
-def resolve_impact(
-    state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, resting, n_rest
-):
+def resolve_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, resting, n_rest):
     """The impact of hitting[0] with resting[:n_rest] held (paper §2.3), then the
     contacts to hold: resting ones left at rest or separating slower than the completion
     speed, and the hit one if its chatter is completed."""

@@ -15,9 +15,10 @@ goes on at the same time, on the state before the impact:
    contact that leaves, leaves below its chatter completion speed, the impact is taken
    plastic (γ = 0), except for a body landing flat (below);
 4. a body landing flat (every contact of the ground in the impact, all leaving at one
-   speed u⁺ > 0, 0 < γ < 1) bounces flat: each bounce is the next flight's event while
-   u⁺ is above the completion speed; below it the rest of the series is completed in
-   closed form and the run ends at rest at the accumulation time t + 2u⁺/(g(1 − γ))
+   speed u⁺ > 0, 0 < γ < 1) bounces flat: while u⁺ is above the completion speed the
+   next step flies to the next flat landing, 2u⁺/g later (phases.flat_flight_step), and
+   the law resolves it on every contact; below it the rest of the series is completed
+   in closed form and the run ends at rest at the accumulation time t + 2u⁺/(g(1 − γ))
    (`complete_flat_bounces`), pushed as a chatter accumulation time;
 5. the loop's next step resolves the contacts touching after the impact as its start
    does (`state.recheck`: holds those at rest, a contact turned round is a new impact).
@@ -39,7 +40,7 @@ from .multi_impact import apply_impulses, delassus_system
 from .output import push_accumulation, push_impact, push_sample
 from .records import STATUS_FLAT_REST, STATUS_LAW_UNDECIDED, LawWork
 from .rotation import qmul, rotation_vector_quaternion
-from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
+from .tolerances import EPS, GAP_NOISE_ULPS
 
 # touching: gap within this many roundoff bands of |z| + a (the loop reaches a contact
 # to a few ulps of it; two reached together are within its resolution)
@@ -75,18 +76,23 @@ def law_event(state, model, pts, opts, stats, out, ws, cs, named, n_named):
     flat = _flat_leaving(model, k, u_post, vnoise)
     if _bounces_are_small(y, model, pts, opts, contacts, k, u_post, vnoise):
         if flat:
-            return _finish(state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, True)
+            return _finish(
+                state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, True, True
+            )
         status, _ = solve_law(model.law, W, u_pre, 0.0, k, lam, u_post, work)
         if status != SETTLED:
             return _undecided(state, status, contacts, k)
         stats.chatter_completions += 1
-    return _finish(state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, False)
+    return _finish(
+        state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, flat, False
+    )
 
 
 @hot
-def _finish(state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, flat_end):
-    """Apply the impulses, push the rows; the flat series completed (flat_end) or the
-    touching contacts resolved at the next step."""
+def _finish(state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, flat, flat_end):
+    """Apply the impulses, push the rows; then the flat series completed (flat_end), the
+    flight to the next flat landing (flat) or the touching contacts resolved at the
+    next step."""
     y = state.y
     apply_impulses(y, model, pts, contacts, k, lam)
     stats.simultaneous_impacts += 1
@@ -99,7 +105,10 @@ def _finish(state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post
         complete_flat_bounces(state, model, opts, stats, out, u)
         return False
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
-    state.recheck = True
+    if flat:
+        state.flat_u = u  # the next step flies to the next flat landing
+    else:
+        state.recheck = True
     return True
 
 

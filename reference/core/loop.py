@@ -39,6 +39,7 @@ from .phases import (
     begin_contact_phase,
     close_contact_phase,
     contact_step,
+    flat_flight_step,
     flight_step,
 )
 from .records import (
@@ -205,6 +206,8 @@ def loop_step(state, model, pts, opts, stats, out, ws, cs):
         return contact_step(state, model, pts, opts, stats, out, ws, cs)
     if _motion_ended(state, model, opts, out):
         return 0
+    if state.flat_u > 0.0:
+        return flat_flight_step(state, model, pts, opts, stats, out, ws, cs)
     if state.n_active > 0:
         begin_contact_phase(state, model, opts)
         return contact_step(state, model, pts, opts, stats, out, ws, cs)

@@ -42,8 +42,8 @@ def law_impact(
 ):  # fmt: skip
     """In place: the impact of contacts[:k] on state y under `law` (a code of
     reference.core.laws; order[:n_order] the sequential law's order as positions in
-    contacts, empty: the fastest first), restitution model.gamma.  Fills u_pre, lam, u_post (per contact) and
-    result[:3] = (status, number of single impacts: 1 for Moreau, 1 if the bounces were
+    contacts, empty: the fastest first), restitution model.gamma.  Fills u_pre, lam,
+    u_post (per contact) and result[:3] = (status, number of single impacts: 1 for Moreau, 1 if the bounces were
     completed); y changes only when the law settled.
 
     Chatter completion, as for a single impact (reference.core.chatter): when every

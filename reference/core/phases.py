@@ -39,6 +39,7 @@ from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
 from .jit import copy_into, hot
+from .law_event import law_event
 from .layout import VX, VY, VZ, WX, WY, WZ
 from .output import push_phase, push_sample
 from .records import (
@@ -131,22 +132,11 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     if s_floor >= 0.0:
         s_end = s_floor
         free_flight(y, fc, model.gravity, s_end, ws.y_event)
-    n_grid = grid_count(state.t_hi, state.t_lo, s_end, opts.sample_dt)
-    if _needed(n_grid, out, opts):
+    if _no_rows_for_flight(state, opts, out, s_end):
         return NEEDS_ROWS
     stats.flight_searches += 1
     stats.search_iterations += ev.iterations
-    k, dt, n = grid_times(state.t_hi, state.t_lo, s_end, opts.sample_dt, n_grid + 1)
-    for i in range(n):
-        s = grid_time(k + i, dt, state.t_hi, state.t_lo)
-        free_flight(y, fc, model.gravity, s, ws.y_chunk)
-        hi, lo = two_sum_add(state.t_hi, state.t_lo, s)
-        push_sample(out, hi, lo, ws.y_chunk, model, opts.max_samples)
-    t0 = state.t_hi
-    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_end)
-    copy_into(y, ws.y_event)
-    push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
-    push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+    fly_to(state, model, opts, out, ws, fc, s_end)
     if s_floor >= 0.0:
         end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
         return DONE
@@ -158,6 +148,57 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     resolve_impact(
         state, model, pts, opts, stats, out, ws, cs, cs.together, ev.n_together, state.active, 0
     )
+    return DONE
+
+
+@hot
+def _no_rows_for_flight(state, opts, out, s_end):
+    """Whether the samples of a flight of s_end do not fit in the free rows."""
+    return _needed(grid_count(state.t_hi, state.t_lo, s_end, opts.sample_dt), out, opts)
+
+
+@hot
+def fly_to(state, model, opts, out, ws, fc, s_end):
+    """The free flight from the state to ws.y_event at s_end (its grid samples, its
+    phase row, the state and time advanced; rows checked by `_no_rows_for_flight`)."""
+    y = state.y
+    n_grid = grid_count(state.t_hi, state.t_lo, s_end, opts.sample_dt)
+    k, dt, n = grid_times(state.t_hi, state.t_lo, s_end, opts.sample_dt, n_grid + 1)
+    for i in range(n):
+        s = grid_time(k + i, dt, state.t_hi, state.t_lo)
+        free_flight(y, fc, model.gravity, s, ws.y_chunk)
+        hi, lo = two_sum_add(state.t_hi, state.t_lo, s)
+        push_sample(out, hi, lo, ws.y_chunk, model, opts.max_samples)
+    t0 = state.t_hi
+    state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_end)
+    copy_into(y, ws.y_event)
+    push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
+    push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
+
+
+@hot
+def flat_flight_step(state, model, pts, opts, stats, out, ws, cs):
+    """The flight after a flat bounce (law_event): the body left every contact at one
+    speed u = state.flat_u, flat, so it lands flat again after 2u/g (its height returns
+    in closed form; its attitude, turning about the vertical, stays flat), where the
+    law resolves the landing on all its contacts.  The run's end (t_end) comes first
+    when it is sooner."""
+    y = state.y
+    s_end = 2.0 * state.flat_u / model.gravity
+    remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
+    landing = s_end <= remaining
+    if not landing:
+        s_end = remaining
+    if _no_rows_for_flight(state, opts, out, s_end):
+        return NEEDS_ROWS
+    fc = flight_constants(y, model.i1, model.i3)
+    free_flight(y, fc, model.gravity, s_end, ws.y_event)
+    fly_to(state, model, opts, out, ws, fc, s_end)
+    state.flat_u = 0.0
+    if landing:
+        for i in range(model.n_contacts):
+            cs.near[i] = i
+        law_event(state, model, pts, opts, stats, out, ws, cs, cs.near, model.n_contacts)
     return DONE
 
 
@@ -357,7 +398,17 @@ def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, cs, cs.hitting, n_hit, ws.held,
+            state,
+            model,
+            pts,
+            opts,
+            stats,
+            out,
+            ws,
+            cs,
+            cs.hitting,
+            n_hit,
+            ws.held,
             state.n_active,
         )
         return DONE

@@ -129,6 +129,7 @@ STATE = np.dtype(
         ("law_t_lo", np.float64),  # happened at it (reference.core.law_event)
         ("law_repeats", np.int64),
         ("law_outcome", np.int64),  # why a law left the impact undecided (law_event)
+        ("flat_u", np.float64),  # > 0: flying after a flat bounce at this speed (law_event)
     ]
 )
 
