@@ -270,14 +270,6 @@ _INITIAL_FULL = {"position", "rotation_vector", "velocity", "angular_velocity"}
 _RUN_KEYS = {"t_end", "max_impacts"}
 
 
-def load_scene(path_or_name: str | Path) -> Scene:
-    """A scene from a file or the name of a built-in scene (reference.scenes:
-    "pentagon-bounce"), validated."""
-    from .scenes import resolve_scene
-
-    return resolve_scene(path_or_name)
-
-
 def load_scene_file(path: str | Path) -> Scene:
     """Read and validate a scene file (a regular UTF-8 TOML file of at most
     MAX_SCENE_FILE_BYTES)."""

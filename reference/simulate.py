@@ -33,7 +33,7 @@ from .core.records import (
     RETURN_GROW,
 )
 from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
-from .geometry import contact_points, initial_state
+from .geometry import initial_state
 from .options import ReferenceOptions
 from .scene import (
     Scene,
@@ -72,7 +72,7 @@ class Problem:
     """The records and arrays one run of the loop reads and writes."""
 
     run: np.ndarray  # records.RUN, 1 element: model, options, state, counters, scratch
-    points: np.ndarray  # (k, 3) contact points
+    points: np.ndarray  # (k, 4) contact points and kinds (GroundContacts.core_points)
     sample_t: np.ndarray
     sample_y: np.ndarray
     sample_e: np.ndarray
@@ -194,7 +194,7 @@ def initial_record(y0: np.ndarray) -> np.ndarray:
 
 def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
     rows = output_rows(min(scene.run.max_impacts, FIRST_IMPACTS), t_end, opts)
-    points = np.array(contact_points(scene.body, scene.ground), dtype=float, order="C")
+    points = np.array(scene.contacts.core_points)  # (the loop's own, writable copy)
     contact_ints, contact_floats = R.new_contact_arrays(len(points))
     run = np.zeros(1, dtype=R.RUN)
     run["model"] = model_record(scene)

@@ -84,7 +84,7 @@ def test_the_core_forms_the_same_delassus_matrix_the_test_derives():
     W, chol = np.zeros((k, k)), np.zeros((k, k))
     u_pre, lam, u_post, vec = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(2 * k)
     active, result = np.zeros(k, dtype=np.int64), np.zeros(3, dtype=np.int64)
-    pts = np.ascontiguousarray(scene.contacts.points, dtype=float)
+    pts = np.ascontiguousarray(scene.contacts.core_points, dtype=float)
     function("multi_impact")(
         y.copy(), model_record(scene), pts, LAW_MOREAU, cs, k, np.zeros(0, dtype=np.int64), 0,
         10, 1e-6, W, u_pre, lam, u_post, chol, vec, active, result,

@@ -74,7 +74,7 @@ def _completes(state, model, pts, ws, k, m, u, vnoise):
     """Whether contact k, separating at u ≤ the completion speed with cand[:m] held,
     falls back (a_n < 0) or is at rest: then its chatter is completed."""
     acc = held_acceleration(state.y, model, pts, ws.cand, m, ws)
-    a_n = contact_jet(state.y, contact_kind(model, k), pts, k, acc).accel
+    a_n = contact_jet(state.y, contact_kind(pts, k), pts, k, acc).accel
     return a_n < 0 or u <= vnoise, a_n
 
 
@@ -111,7 +111,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, 
         return False
     k = hitting[0]
     stats.max_penetration = max(
-        stats.max_penetration, -contact_frame(y, contact_kind(model, k), pts, k).gap
+        stats.max_penetration, -contact_frame(y, contact_kind(pts, k), pts, k).gap
     )
     vnoise = rate_noise(y, model.radius)
     copy_into(ws.y_start, y)
@@ -130,7 +130,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, 
     m = 0
     vs = velocity_scale(y, model.radius)
     for i in range(n_rest):
-        kind = contact_kind(model, resting[i])
+        kind = contact_kind(pts, resting[i])
         vn = normal_velocity(y, contact_frame(y, kind, pts, resting[i]), kind)
         if vn <= small:
             ws.cand[m] = resting[i]
@@ -251,7 +251,7 @@ def resolve_touching(state, model, pts, opts, stats, out, ws, cs):
     n_hit = n_rest = 0
     hitting, resting = cs.hitting, cs.together
     for k in range(pts.shape[0]):
-        kind = contact_kind(model, k)
+        kind = contact_kind(pts, k)
         f = contact_frame(y, kind, pts, k)
         if f.gap > f.noise:
             continue

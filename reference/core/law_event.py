@@ -160,7 +160,7 @@ def touching_set(y, model, pts, named, n_named, contacts):
     gap_tol = TOUCH_ULPS * EPS * (abs(y[2]) + model.radius)
     v_tol = rate_noise(y, model.radius)
     for c in range(pts.shape[0]):
-        kind = contact_kind(model, c)
+        kind = contact_kind(pts, c)
         f = contact_frame(y, kind, pts, c)
         if f.gap > gap_tol or _named(contacts, n_named_set, c):
             continue

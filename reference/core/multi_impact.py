@@ -16,13 +16,13 @@ from .records import LawWork
 def delassus_system(y, model, pts, contacts, k, W, u):
     """W[:k, :k] = J M⁻¹ Jᵀ and u[:k] = J (v, ω) for the contacts[:k] at state y."""
     for i in range(k):
-        ki = contact_kind(model, contacts[i])
+        ki = contact_kind(pts, contacts[i])
         fi = contact_frame(y, ki, pts, contacts[i])
         u[i] = normal_velocity(y, fi, ki)
         resp = impulse_response(y, fi, model.mass, model.i1, model.i3)
         W[i, i] = resp.w
         for j in range(i):
-            fj = contact_frame(y, contact_kind(model, contacts[j]), pts, contacts[j])
+            fj = contact_frame(y, contact_kind(pts, contacts[j]), pts, contacts[j])
             W[i, j] = W[j, i] = response_rate(fj, resp)
 
 
@@ -31,7 +31,7 @@ def apply_impulses(y, model, pts, contacts, k, lam):
     """In place: (v, ω) += Σ Λᵢ M⁻¹Jᵢᵀ."""
     for i in range(k):
         if lam[i] != 0.0:
-            f = contact_frame(y, contact_kind(model, contacts[i]), pts, contacts[i])
+            f = contact_frame(y, contact_kind(pts, contacts[i]), pts, contacts[i])
             apply_impulse(y, impulse_response(y, f, model.mass, model.i1, model.i3), lam[i])
 
 
@@ -43,8 +43,8 @@ def law_impact(
     """In place: the impact of contacts[:k] on state y under `law` (a code of
     reference.core.laws; order[:n_order] the sequential law's order as positions in
     contacts, empty: the fastest first), restitution model.gamma.  Fills u_pre, lam,
-    u_post (per contact) and result[:3] = (status, number of single impacts: 1 for Moreau, 1 if the bounces were
-    completed); y changes only when the law settled.
+    u_post (per contact) and result[:3] = (status, number of single impacts: 1 for
+    Moreau, 1 if the bounces were completed); y changes only when the law settled.
 
     Chatter completion, as for a single impact (reference.core.chatter): when every
     contact that leaves, leaves slower than its `completion_speed`, the bounces that

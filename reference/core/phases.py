@@ -375,7 +375,7 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
         k = (first + i) % n
         if is_held(state, k):
             continue
-        f = contact_frame(y, contact_kind(model, k), pts, k)
+        f = contact_frame(y, contact_kind(pts, k), pts, k)
         if f.gap < -max(f.noise, gap_res):
             cs.together[m] = k
             m += 1

@@ -47,6 +47,12 @@ EVENT_STUCK = 3  # the search did not converge
 RIM_VERTEX_ON_PLANE = 0  # a body-frame rim vertex against the plane z = 0, normal +z
 FLOOR_POINT_ON_FACE = 1  # a fixed world point touching the body's face, normal e3
 
+# The core's contact points are (n, POINT_COLUMNS) rows: the point (body-frame for a rim
+# vertex, world for a floor point) and, in column KIND_COLUMN, the contact's kind
+# (reference.contact_kinds.GroundContacts.core_points).
+KIND_COLUMN = 3
+POINT_COLUMNS = 4
+
 # Invariants of the motion that every contact force of a ground keeps (bits): vertical
 # forces keep the horizontal momentum and L_z; forces along e3 through the face keep
 # the spin ω3 of the axisymmetric body (the energy's resting level, inertia.excess_energy).

@@ -54,6 +54,7 @@ from ..core.records import LawWork
 from ..core.tolerances import EPS
 from ..trajectory import Status
 from . import kernel as K
+from .segment import LinearRun, run_message, run_segment
 
 # the fields of a LinearRun that have one entry per event row
 ROW_FIELDS = (
@@ -369,7 +370,6 @@ def run_under_law(
     """`simulate.run_linear` under `law` (`moreau` or `sequential`): kernel segments
     under the paper's rule, each undecidable stop resolved by the law and the kernel
     restarted after it (module docstring).  Returns one LinearRun over all segments."""
-    from .simulate import LinearRun, run_message, run_segment
 
     resolving = [x.name for x in resolving_laws()]
     if law not in resolving:
