@@ -25,7 +25,7 @@ impact.  Under `moreau` or `sequential` the run goes on from there (`run_under_l
 4. a body landing flat (every contact in the impact, all leaving at one speed u⁺ > 0,
    0 < γ < 1) bounces flat for ever: the series is completed in closed form and the run
    ends at rest (`singularity`, all contacts down) at t + 2u⁺/(g(1 − γ))
-   (`flat_bounce_time`);
+   (`bounce_series`);
 5. otherwise the kernel restarts from the state after the impact (its start closes the
    contacts left at zero normal velocity: the held-contact phases), with t_end,
    max_impacts and the energy floor kept those of the whole run.
