@@ -96,9 +96,12 @@ class GroundContacts:
         return int(self.kinds[k])
 
     def label(self, k: int) -> str:
-        """'v2' (rim vertex 2) or 'b1' (floor point 1: numbered among the floor points)."""
+        """'v2' (rim vertex 2) or 'b1' (floor point 1: numbered among the contacts of its
+        kind); '#k' for a number that is no contact of this ground."""
+        if not 0 <= k < self.n:
+            return f"#{k}"
         kind = self.kind(k)
-        return f"{KIND_LABEL[kind]}{k if kind == RIM_VERTEX_ON_PLANE else k - self.n_rim}"
+        return f"{KIND_LABEL[kind]}{int(np.count_nonzero(self.kinds[:k] == kind))}"
 
     def lever(self, k: int) -> float:
         """Contact k's distance from the symmetry axis when the body lies flat on the
