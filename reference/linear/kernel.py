@@ -498,7 +498,7 @@ def law_contacts(F, q, p, qs, ps, vfl, out):
     contact touching the ground within roundoff and not separating beyond it (normal
     velocity f_cᵀp ≤ its roundoff level), into out; returns how many.  Held contacts
     (resting) are in, a contact leaving is not: a law's impulse on a separating contact
-    could do positive work (docs/architecture.md, "Impact laws")."""
+    could do positive work (docs/laws.md, "The laws")."""
     n = 0
     for c in range(F.shape[0]):
         if _touching(F, c, q, qs) and _dot(F, c, p) <= _tol(F, c, ps, vfl):

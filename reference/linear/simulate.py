@@ -316,8 +316,8 @@ def simulate_linear(
     from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
     max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
     listed in stats["accumulations"], not as impacts.  The scene's `impact_law` and
-    `simultaneity_window` apply (laws.py; docs/architecture.md, "The linear model under
-    the laws")."""
+    `simultaneity_window` apply (laws.py; docs/laws.md, "The linear model under the
+    laws")."""
     from ..checks import check_linear_options, run_horizon
     from ..scenes import as_scene
     from .exponent_estimates import extrapolate_time_to_go
