@@ -104,7 +104,7 @@ class Body:
 class Ground:
     """The scene file's [ground]: `flat`, the plane z = 0 that the body's rim vertices
     touch; `three_point`, floor points (bumps) at (b cos 2πk/3, b sin 2πk/3, 0) that
-    touch the body's face; `bumpy` (issue 32), both: the plane under the rim and bumps
+    touch the body's face; `bumpy`, both: the plane under the rim and bumps
     above it under the face, `bumps` (x, y, height) or three at (b cos 2πk/3,
     b sin 2πk/3, bump_height).  Lengths in the scene's units, like the body's radius.
     On `three_point` ground the floor plane lies `floor_depth` below the bumps' tops

@@ -1,4 +1,4 @@
-"""Impact laws for several touching contacts at once (paper §2.3 generalised; issue 31).
+"""Impact laws for several touching contacts at once (paper §2.3 generalised).
 
 Plain functions of plain data: the k touching contacts enter only through their
 Delassus matrix W = J M⁻¹ Jᵀ (k × k, symmetric positive semi-definite: an impulse

@@ -146,7 +146,7 @@ def run_linear(
     `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
     or `moreau` / `sequential`: the run goes on past it under that law (laws.py).
     `simultaneity_window`: open contacts reaching the ground within this time of the
-    first are reached together with it (0: strictly sequential, as before issue 31)."""
+    first are reached together with it (0: strictly sequential)."""
     if impact_law != "paper":
         from .laws import run_under_law
 
