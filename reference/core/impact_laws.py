@@ -37,7 +37,7 @@ Laws (registered in reference.core.laws, which names them and gives their codes)
   turn: the orders of `harness branches`).  At most MAX_SEQUENTIAL_IMPACTS single
   impacts; beyond, status NOT_SETTLED.
 
-No energetic law (Darboux–Keller, Stronge, LZB): see docs/architecture.md, "Impact
+No energetic law (Darboux–Keller, Stronge, LZB): see docs/laws.md, "The
 laws" (not exact in closed form: an ODE in the impulse with switching, and LZB needs
 contact stiffness ratios the rigid model has no value for).
 """

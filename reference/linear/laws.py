@@ -1,6 +1,6 @@
 """The linear model past undecidable states, under the exact reference's impact laws
-(the registry reference.core.laws; the exact core resolves them inside its loop,
-reference.core.law_event).
+(docs/laws.md; the registry reference.core.laws; the exact core resolves them inside its
+loop, reference.core.law_event).
 
 The linear kernel applies the paper's rule: where several contacts touch at an impact
 (two reached at once, an impact that would push a held contact, a contact at the ground
