@@ -61,14 +61,22 @@ def law_event(state, model, pts, opts, stats, out, ws, cs, named, n_named):
     if not _progress(state):
         return _undecided(state, NO_PROGRESS, named, n_named)
     y = state.y
-    k = touching_set(y, model, pts, named, n_named, cs.law_contacts)
+    K = cs.law_mats.shape[1]  # the scratch's contacts (ContactLists.law_mats)
+    contacts = cs.law_ints[:K]
+    k = touching_set(y, model, pts, named, n_named, contacts)
     if k < 0:
         return _undecided(state, TOO_MANY, named, n_named)
-    contacts = cs.law_contacts
-    W, u_pre, lam, u_post = cs.W, cs.u_pre, cs.lam, cs.u_post
+    W, chol = cs.law_mats[:K], cs.law_mats[K:]
+    v = cs.law_vecs
+    u_pre, lam, u_post, vec = v[:K], v[K : 2 * K], v[2 * K : 3 * K], v[3 * K :]
+    active, order_pos, order = (
+        cs.law_ints[K : 2 * K],
+        cs.law_ints[2 * K : 3 * K],
+        cs.law_ints[3 * K :],
+    )
     delassus_system(y, model, pts, contacts, k, W, u_pre)
-    n_order = order_positions(contacts, k, cs.order, opts.n_order, cs.order_pos)
-    work = LawWork(cs.chol, cs.vec, cs.active, cs.order_pos, n_order, MAX_SEQUENTIAL_IMPACTS)
+    n_order = order_positions(contacts, k, order, opts.n_order, order_pos)
+    work = LawWork(chol, vec, active, order_pos, n_order, MAX_SEQUENTIAL_IMPACTS)
     status, _ = solve_law(model.law, W, u_pre, model.gamma, k, lam, u_post, work)
     if status != SETTLED:
         return _undecided(state, status, contacts, k)

@@ -19,17 +19,12 @@ ContactLists = namedtuple(
         "hitting",  # (n,) contacts hitting
         "near",  # (n,) contacts approaching within the gap resolution, watched
         # a simultaneous impact under an impact law (reference.core.law_event), for up
-        # to K contacts: K = 1 under `paper`, which never uses them
-        "W",  # (K, K) Delassus matrix
-        "chol",  # (K, K) the law's factor
-        "u_pre",  # (K,) normal velocities before
-        "lam",  # (K,) impulses
-        "u_post",  # (K,) normal velocities after
-        "vec",  # (2K,) the law's scratch
-        "law_contacts",  # (K,) the contacts of the impact
-        "active",  # (K,) the law's active set
-        "order_pos",  # (K,) that order as positions in law_contacts
-        "order",  # the sequential law's order of contacts (options.n_order of them)
+        # to K contacts (K = 1 under `paper`, which never uses them): three arrays
+        # (records.new_law_arrays), sliced where they are used (`law_lists`), so that
+        # the lists every event function passes grow by three arrays only
+        "law_mats",  # (2K, K) W, the law's factor
+        "law_vecs",  # (5K,) u⁻, Λ, u⁺, the law's scratch (2K)
+        "law_ints",  # (3K + m,) contacts, active set, order positions, the order (m)
     ],
 )
 
@@ -40,10 +35,7 @@ def contact_lists(ints, floats, law_mats, law_vecs, law_ints):
     the order of records.CONTACT_INT_ROWS and CONTACT_FLOAT_ROWS; records.new_law_arrays);
     compiled with numba's reference counting, as the loop's entry point is, since the
     rows are views."""
-    k = law_mats.shape[1]
     return ContactLists(
         ints[0], floats[0], floats[1], floats[2], floats[3], ints[1], ints[2], ints[3],
-        law_mats[:k], law_mats[k:], law_vecs[:k], law_vecs[k : 2 * k],
-        law_vecs[2 * k : 3 * k], law_vecs[3 * k :], law_ints[:k], law_ints[k : 2 * k],
-        law_ints[2 * k : 3 * k], law_ints[3 * k :],
+        law_mats, law_vecs, law_ints,
     )  # fmt: skip
