@@ -39,6 +39,7 @@ from .records import (
     EVENT_IMPACT,
     EVENT_NONE,
     EVENT_STUCK,
+    FLOOR_POINT_ON_FACE,
     RIM_VERTEX_ON_PLANE,
     FlightEvent,
     Jet,
@@ -199,8 +200,10 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
     other, other_k = math.inf, -1.0
     if n_rim < n:
         cols = rotation_columns_xy(y)  # (unused by a floor point's frame)
-        for k in range(n_rim, n):  # the floor points, after the rim vertices
-            examine(y, acc, cols, contact_kind(pts, k), pts, k, K, B, vnoise, res)
+        for k in range(n_rim, n):  # the floor points, after the rim vertices: their
+            # kind as a constant keeps `examine` inlined for it (docs/performance.md,
+            # "Event search"); GroundContacts lists each kind in one range
+            examine(y, acc, cols, FLOOR_POINT_ON_FACE, pts, k, K, B, vnoise, res)
         if n_rim == 0:
             return res[STEP], last_dlt
         other, other_k = res[STEP], res[STEP_K]
