@@ -37,6 +37,7 @@ from .core.impact_laws import (
     SINGULAR,
     TOO_MANY,
 )
+from .core.compliant import work_size
 from .core.tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
 from .geometry import contact_kinematics, excess_energy
 from .quaternion import from_rotation_vector, multiply
@@ -99,7 +100,8 @@ def apply_law(
         ordered += [i for i in range(k) if i not in ordered]
     order_idx = np.array(ordered, dtype=np.int64)
     W, chol = np.zeros((k, k)), np.zeros((k, k))
-    u_pre, lam, u_post, vec = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(2 * k)
+    u_pre, lam, u_post = np.zeros(k), np.zeros(k), np.zeros(k)
+    vec = np.zeros(max(2 * k, work_size(k)))  # the laws' scratch (compliant's the largest)
     active, result = np.zeros(k, dtype=np.int64), np.zeros(3, dtype=np.int64)
     function("multi_impact")(
         y, model_record(scene), pts, LAW_NAMES.index(law), cs, k, order_idx, len(order_idx),

@@ -50,7 +50,8 @@ from .jit import hot
 LAW_PAPER = 0
 LAW_MOREAU = 1
 LAW_SEQUENTIAL = 2
-LAW_NAMES = ("paper", "moreau", "sequential")
+LAW_COMPLIANT = 3
+LAW_NAMES = ("paper", "moreau", "sequential", "compliant")
 
 # Outcomes of a law's solve
 SETTLED = 0
