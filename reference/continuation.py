@@ -29,6 +29,7 @@ import numpy as np
 
 from .core import layout as L
 from .core import records as R
+from .core.compliant import work_size
 from .core.impact_laws import (
     LAW_NAMES,
     MAX_LAW_CONTACTS,
@@ -37,7 +38,6 @@ from .core.impact_laws import (
     SINGULAR,
     TOO_MANY,
 )
-from .core.compliant import work_size
 from .core.tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
 from .geometry import contact_kinematics, excess_energy
 from .quaternion import from_rotation_vector, multiply

@@ -99,9 +99,11 @@ def damping_ratio(gamma):
             lo = mid
         else:
             hi = mid
-    return hi if abs(restitution_of_damping(hi) - gamma) <= abs(
-        restitution_of_damping(lo) - gamma
-    ) else lo
+    return (
+        hi
+        if abs(restitution_of_damping(hi) - gamma) <= abs(restitution_of_damping(lo) - gamma)
+        else lo
+    )
 
 
 def work_size(k):
@@ -199,11 +201,14 @@ def _propagator(B, h, n, P, T, S):
 @hot
 def _switches(W, u_pre, wbar, ubar, kappa, damp, active, z, k, i):
     """Whether contact i's pushing state at z differs from `active`: a pushing contact
-    whose force is negative, a free one with dᵢ > 0 and a positive force."""
+    whose force is below −its roundoff, a free one with dᵢ > 0 and a force above it
+    (the roundoff band keeps a contact that hovers at zero force from switching on
+    noise)."""
     f = _force(W, u_pre, wbar, ubar, kappa, damp, z, k, i)
+    tol = REST_ULPS * EPS * (kappa + damp[i])
     if active[i]:
-        return f < 0.0
-    return z[i] > 0.0 and f > 0.0
+        return f < -tol
+    return z[i] > 0.0 and f > tol
 
 
 @hot
@@ -331,9 +336,20 @@ def compliant_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
 def _run(W, u_pre, gamma, k, wbar, ubar, work, active):
     """The impact in scaled units; the state z ends in work (see compliant_impulses)."""
     n = 2 * k + 1
-    B, P, T, S = work[: n * n], work[n * n : 2 * n * n], work[2 * n * n : 3 * n * n], work[3 * n * n : 4 * n * n]
+    B, P, T, S = (
+        work[: n * n],
+        work[n * n : 2 * n * n],
+        work[2 * n * n : 3 * n * n],
+        work[3 * n * n : 4 * n * n],
+    )
     o = 4 * n * n
-    z, z1, zt, term, tmp = work[o : o + n], work[o + n : o + 2 * n], work[o + 2 * n : o + 3 * n], work[o + 3 * n : o + 4 * n], work[o + 4 * n : o + 5 * n]
+    z, z1, zt, term, tmp = (
+        work[o : o + n],
+        work[o + n : o + 2 * n],
+        work[o + 2 * n : o + 3 * n],
+        work[o + 3 * n : o + 4 * n],
+        work[o + 4 * n : o + 5 * n],
+    )
     damp = work[o + 5 * n : o + 5 * n + k]
     kappa = _setup(W, u_pre, gamma, k, wbar, z, damp, active)
     tol = REST_ULPS * EPS

@@ -4,8 +4,8 @@ impulses (reference.core.impact_laws), and (v, ω) += M⁻¹JᵀΛ.  Positions a
 (paper §2.3: impacts are instantaneous)."""
 
 from .chatter import completion_speed
-from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
 from .compliant import compliant_impulses
+from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
 from .impact_laws import (
     LAW_COMPLIANT,
     LAW_MOREAU,
