@@ -39,3 +39,35 @@ def plot_spread(spread, path: str | os.PathLike) -> str:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return str(path)
+
+
+def plot_engines(studies, path: str | os.PathLike) -> str:
+    """Distance to each outcome against dt, one panel per landing, one colour per
+    outcome, one marker per engine."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(studies), figsize=(5.5 * len(studies), 4.5), squeeze=False)
+    markers = "osD^v<>px"
+    for ax, st in zip(axes[0], studies, strict=True):
+        engines = sorted({r.engine for r in st.runs})
+        for j, o in enumerate(st.outcomes):
+            for m, engine in enumerate(engines):
+                pts = [
+                    (r.dt, r.distances[o.name]) for r in st.runs
+                    if r.engine == engine and r.dt is not None and o.name in r.distances
+                ]  # fmt: skip
+                if pts:
+                    x, y = zip(*sorted(pts), strict=True)
+                    ax.loglog(x, np.maximum(y, 1e-16), marker=markers[m % len(markers)],
+                              color=f"C{j}", label=f"{engine}: {o.name}")  # fmt: skip
+        ax.set_xlabel("dt")
+        ax.set_ylabel("distance after the impact")
+        ax.set_title(st.scene)
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return str(path)
