@@ -40,11 +40,11 @@ from reference.core import layout as L
 from reference.scene import velocity_unit
 
 from ..horizon.state import flown, scene_at
+from .follow import FOLLOW_FACTOR
 from .spread import ordered_runs
 
 LEAD = 0.02  # the engines start this long (in a/U) before t_u
 AFTER = 0.1  # and are measured this long after it (at most; half the gap to the next impact)
-FOLLOW_FACTOR = 3.0
 EXACT_DISTANCE = 1e-9
 FAR_DISTANCE = 0.5
 SAME_OUTCOME = 1e-9  # branches closer than this (dimensionless) are one outcome
