@@ -88,8 +88,9 @@ def branch_lines(result: CompareResult) -> list[str]:
         "impacts after t_u in windows plus the energy difference over E(t_u); ≈: no branch "
         f"{FOLLOW_FACTOR:g} times nearer than the next (which law an engine follows: "
         "harness branches SCENE --engine E --dt ..., docs/laws.md). impacts: k+s/N of "
-        "the branch's impacts after t_u reproduced in order (s chatter tails skipped), until the first "
-        "disagreement. on ref: the run had not diverged from the reference before t_u."
+        "the branch's impacts after t_u reproduced in order (s chatter tails skipped), "
+        "until the first disagreement. on ref: the run had not diverged from the "
+        "reference before t_u."
     )
     shown = [table(rows, header, align="llrlrrl")] if rows else []
     return [*textwrap.wrap(head, WIDTH), *shown, *left, *textwrap.wrap(legend, WIDTH)]
