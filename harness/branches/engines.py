@@ -44,7 +44,8 @@ from .follow import FOLLOW_FACTOR
 from .spread import ordered_runs
 
 LEAD = 0.02  # the engines start this long (in a/U) before t_u
-AFTER = 0.1  # and are measured this long after it (at most; half the gap to the next impact)
+AFTER = 0.1  # and measured at most this long after it (half the gap to the next impact)
+AFTER_MIN = 0.02  # but at least this long after it
 EXACT_DISTANCE = 1e-9
 FAR_DISTANCE = 0.5
 SAME_OUTCOME = 1e-9  # branches closer than this (dimensionless) are one outcome
@@ -93,6 +94,7 @@ class ImpactStudy:
     outcomes: list[Outcome]
     runs: list[EngineAtImpact]
     message: str = ""
+    apart: float = math.inf  # the least distance between two outcomes
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -100,6 +102,7 @@ class ImpactStudy:
             "contacts": self.contacts, "lead": self.lead, "after": self.after,
             "outcomes": [{"name": o.name, "branches": o.names, "law": o.law,
                           "order": list(o.order) if o.order else None} for o in self.outcomes],
+            "outcomes_apart": self.apart if math.isfinite(self.apart) else None,
             "runs": [r.to_dict() for r in self.runs], "message": self.message,
         }  # fmt: skip
 
@@ -156,44 +159,52 @@ def branch_list(contacts: list[int]) -> list[tuple[str, str, tuple[int, ...] | N
     return [(law, law, None) for law in LAWS] + ordered_runs(contacts)
 
 
-def branch_states(scene, t_m: float, branches) -> list[tuple[str, str, Any, np.ndarray]]:
-    """(name, law, order, state at t_m) of each branch: the exact reference to t_m."""
+def law_run(scene, t_end: float, law: str, order=None):
+    """The exact reference under `law` (and `order`) to t_end."""
     from reference import ReferenceOptions, simulate
 
-    out = []
-    for name, law, order in branches:
-        opts = ReferenceOptions(impact_law=law, sequential_order=order)
-        traj = simulate(scene, t_end=t_m, options=opts)
-        out.append((name, law, order, state_of(traj)))
-    return out
+    opts = ReferenceOptions(impact_law=law, sequential_order=order)
+    return simulate(scene, t_end=t_end, options=opts)
 
 
-def outcomes_of(scene, states, contacts) -> list[Outcome]:
-    """The branches grouped by their state at t_m (within SAME_OUTCOME)."""
+def impact_contacts(scene, t_u: float, touching: list[int]) -> tuple[list[int], float]:
+    """(contacts of the impact, time to the first impact after t_u): those touching and
+    those a law gave an impulse at t_u; the least gap to a later impact over the laws'
+    runs (AFTER a/U at most)."""
+    gap = AFTER * scene.body.radius / velocity_unit(scene)
+    took = set(touching)
+    for law in LAWS:
+        impacts = law_run(scene, t_u + gap, law).impacts
+        t = np.asarray([e.t for e in impacts], dtype=float)
+        took |= {e.contact for e in impacts if e.t == t_u}
+        later = t[t > t_u]
+        gap = min(gap, float(later[0] - t_u)) if later.size else gap
+    return sorted(int(c) for c in took), gap
+
+
+def measure_time(scene, lead: float, gap: float, dts) -> float:
+    """The engines' run, lead + after: after = half the gap to the next impact, at least
+    AFTER_MIN a/U (a chatter's next bounces are then part of what is compared), rounded
+    up to a whole number of the largest dt."""
+    unit = scene.body.radius / velocity_unit(scene)
+    total = lead + max(0.5 * gap, AFTER_MIN * unit)
+    steps = [dt for dt in dts if dt]
+    if steps:
+        total = math.ceil(total / max(steps) - 1e-9) * max(steps)
+    return total
+
+
+def outcomes_at(scene, t_m: float, contacts: list[int]) -> list[Outcome]:
+    """Every branch's state at t_m, grouped by state (within SAME_OUTCOME)."""
     out: list[Outcome] = []
-    for name, law, order, y in states:
+    for name, law, order in branch_list(contacts):
+        y = state_of(law_run(scene, t_m, law, order))
         same = [o for o in out if distance(scene, y, o.state, contacts) <= SAME_OUTCOME]
         if same:
             same[0].names.append(name)
         else:
             out.append(Outcome([name], law, order, y))
     return out
-
-
-def after_time(scene, t_u: float, contacts: list[int]) -> float:
-    """How long after t_u the engines are measured: AFTER (a/U), at most half the time
-    to the first impact after t_u of the moreau and compliant branches."""
-    from reference import ReferenceOptions, simulate
-
-    unit = scene.body.radius / velocity_unit(scene)
-    after = AFTER * unit
-    for law in ("moreau", "compliant"):
-        traj = simulate(scene, t_end=t_u + after, options=ReferenceOptions(impact_law=law))
-        t = traj.impact_times()
-        later = t[t > t_u]
-        if later.size:
-            after = min(after, 0.5 * float(later[0] - t_u))
-    return after
 
 
 def run_engine(engine: str, scene, y0, duration: float, dt, contacts, outcomes) -> EngineAtImpact:
@@ -254,17 +265,20 @@ def study(scene, engines: list[str], dts: list[float | None], t_end: float | Non
                            "no undecidable state: every law gives the same run")  # fmt: skip
     unit = scene.body.radius / velocity_unit(scene)
     y0, lead = start_before(scene, t_u, y_u, LEAD * unit)
-    after = after_time(scene, t_u, contacts)
-    outcomes = outcomes_of(scene, branch_states(scene, t_u + after, branch_list(contacts)),
-                           contacts)  # fmt: skip
+    contacts, gap = impact_contacts(scene, t_u, contacts)
+    duration = measure_time(scene, lead, gap, dts)
+    after = duration - lead
+    outcomes = outcomes_at(scene, t_u + after, contacts)
+    apart = min((distance(scene, a.state, b.state, contacts) for i, a in enumerate(outcomes)
+                 for b in outcomes[i + 1 :]), default=math.inf)  # fmt: skip
     runs = []
     for engine in engines:
         for dt in _engine_dts(engine, dts):
             if progress:
                 progress(f"branches: {engine} dt={dt}")
-            runs.append(run_engine(engine, scene, y0, lead + after, dt, contacts, outcomes))
+            runs.append(run_engine(engine, scene, y0, duration, dt, contacts, outcomes))
     verdicts(runs)
-    return ImpactStudy(scene.name, t_u, contacts, lead, after, outcomes, runs)
+    return ImpactStudy(scene.name, t_u, contacts, lead, after, outcomes, runs, apart=apart)
 
 
 def _engine_dts(engine: str, dts: list[float | None]) -> list[float | None]:

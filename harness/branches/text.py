@@ -49,12 +49,19 @@ def format_study(study) -> str:
         f"{study.scene}: first undecidable state at t_u = {study.t_u:.17g}, contacts "
         f"{study.contacts}; engines start {study.lead:.3g} before it, measured "
         f"{study.after:.3g} after it",
-        "outcomes: " + "; ".join(f"({i + 1}) {o.name}" for i, o in enumerate(study.outcomes)),
+        "outcomes: "
+        + "; ".join(f"({i + 1}) {o.name}" for i, o in enumerate(study.outcomes))
+        + f" (the nearest two {num(study.apart, '.3g')} apart)",
     ]
+    labels = sorted(((o.name, f"({i + 1})") for i, o in enumerate(study.outcomes)),
+                    key=lambda kv: -len(kv[0]))  # fmt: skip
     rows = []
     for r in study.runs:
         dist = [num(r.distances.get(o.name), ".3g") for o in study.outcomes]
-        rows.append([r.engine, num(r.dt, "g"), *dist, r.verdict])
+        text = r.verdict
+        for name, label in labels:
+            text = text.replace(name, label)
+        rows.append([r.engine, num(r.dt, "g"), *dist, text])
     header = ["engine", "dt", *(f"({i + 1})" for i in range(len(study.outcomes))), "verdict"]
     lines.append(table(rows, header, align="lr" + "r" * len(study.outcomes) + "l"))
     legend = (
