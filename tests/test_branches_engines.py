@@ -101,3 +101,13 @@ def test_each_landing_starts_on_several_contacts(name):
     touching = np.flatnonzero(gap[0] <= 1e-14)
     assert len(touching) >= 2
     assert vn[0, touching].min() < -0.1 * velocity_unit(scene)
+
+
+def test_the_plot_is_written_and_named(law_engines, tmp_path, capsys):
+    out = tmp_path / "laws.png"
+    argv = ["branches", "landing-hexagon", "--engine", "as-compliant", "--json", "--plot", str(out)]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert out.stat().st_size > 0 and doc["plot"] == str(out)
+    (run,) = doc["studies"][0]["runs"]
+    assert run["verdict"] == "follows compliant"  # six contacts: the compliant law's own
