@@ -186,7 +186,7 @@ def continue_run(
             return f"the {law} law made no progress at t = {t_hi:.17g}: stopped (undecidable)"
         y = np.array(st["y"][0], dtype=float)
         contacts = touching_contacts(
-            scene, y, law_contacts(st[0]), separating=law == "compliant"
+            scene, y, law_contacts(st[0]), separating=law.startswith("compliant")
         )
         impact = apply_law(scene, y, contacts, law, order, chatter_tol)
         if impact.status == NOT_SETTLED:

@@ -68,7 +68,7 @@ MAX_SPEED = 1e3
 MAX_POSITION = 1e6
 MAX_ROTATION_VECTOR = 1e3
 # the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
-IMPACT_LAWS = ("paper", "moreau", "sequential", "compliant")
+IMPACT_LAWS = ("paper", "moreau", "sequential", "compliant", "compliant-mass")
 DEFAULT_IMPACT_LAW = "paper"
 # the exact reference's simultaneity window [time unit of the scene] under `moreau` and
 # `sequential` when neither the scene nor the options set one (under `paper`: 0,

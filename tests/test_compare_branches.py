@@ -28,8 +28,9 @@ BRANCH_FIELDS = {
 
 @pytest.fixture(scope="module")
 def flat_triangle():
-    """A triangle starting flat on its three vertices: undecidable at t = 0, and nine
-    branches (moreau, sequential, compliant, the sequential law in each order)."""
+    """A triangle starting flat on its three vertices: undecidable at t = 0, and ten
+    branches (moreau, sequential, compliant, compliant-mass, the sequential law in each
+    order)."""
     n, rotation, velocity, omega = STARTS["three (a flat triangle)"]
     scene, _ = _on_ground(n, rotation, velocity, omega)
     return scene, branches(scene)
@@ -48,7 +49,7 @@ def _same_run(a, b) -> bool:
     )
 
 
-@pytest.mark.parametrize("which", range(9))
+@pytest.mark.parametrize("which", range(10))
 def test_a_run_made_of_one_branch_follows_that_branch_to_its_end(flat_triangle, which):
     scene, spread = flat_triangle
     built = spread.branches[which]

@@ -15,6 +15,7 @@ from reference import quaternion as qt
 from reference.core.compliant import (
     SETTLED,
     compliant_impulses,
+    compliant_mass_impulses,
     damping_ratio,
     restitution_of_damping,
     work_size,
@@ -32,10 +33,11 @@ from tests.test_impact_laws import CASES
 ORACLE_TOL = 1e-10
 
 
-def _compliant(W, u, gamma):
+def _compliant(W, u, gamma, mass=False):
     k = len(u)
     lam, u_post = np.zeros(k), np.zeros(k)
-    status = compliant_impulses(
+    solve = compliant_mass_impulses if mass else compliant_impulses
+    status = solve(
         np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(u, dtype=float),
         float(gamma), k, lam, u_post, np.zeros(work_size(k)), np.zeros(k, dtype=np.int64),
     )  # fmt: skip
@@ -58,8 +60,9 @@ def test_the_limits_are_undamped_and_infinitely_damped():
     assert damping_ratio(1.0) == 0.0 and damping_ratio(0.0) == np.inf
 
 
+@pytest.mark.parametrize("mass", [False, True])
 @pytest.mark.parametrize("gamma", [0.0, 0.01, 0.1, np.exp(-2.0), 0.3, 0.7, 0.99, 1.0])
-def test_one_contact_is_eq_F(gamma):
+def test_one_contact_is_eq_F(gamma, mass):
     scene = make_scene(n=5, gamma=gamma)
     model = BodyModel.from_scene(scene)
     y = np.zeros(13)
@@ -67,7 +70,7 @@ def test_one_contact_is_eq_F(gamma):
     y[7:10] = [0.1, -0.2, -0.9]
     y[10:13] = [0.4, 0.3, 1.2]
     _, _, W, u = delassus(model, y, [2])
-    lam, u_post = _compliant(W, u, gamma)
+    lam, u_post = _compliant(W, u, gamma, mass)
     assert u_post[0] == pytest.approx(-gamma * u[0], rel=1e-12, abs=1e-12 * abs(u[0]))
     assert lam[0] == pytest.approx(impact_impulse(model, y, 2, gamma).impulse, rel=1e-12)
 
@@ -172,3 +175,29 @@ def test_a_start_on_several_contacts_takes_the_compliant_impulses(case):
     for c, lam in expected.items():
         assert took[c] == pytest.approx(lam, rel=1e-9)
     assert traj.impact_law == "compliant"
+
+
+@pytest.mark.parametrize("gamma", [0.0, 0.3, 1.0])
+def test_the_mass_scaled_stiffness_keeps_the_invariants(gamma):
+    for scene, y, cs in CASES[::2]:
+        _, _, W, u = delassus(BodyModel.from_scene(scene), y, cs)
+        if u.min() < 0:
+            lam, u_post = _compliant(W, u, gamma, mass=True)
+            _check_invariants(W, u, lam, u_post, gamma)
+
+
+@pytest.mark.parametrize("gamma", [0.2, 0.7])
+@pytest.mark.parametrize("k", [2, 3, 6])
+def test_the_mass_scaled_stiffness_matches_the_oracle(k, gamma):
+    """kᵢ ∝ 1/Wᵢᵢ against the integration with that stiffness; where the Wᵢᵢ differ the
+    outcome differs from the uniform stiffness's."""
+    rng = np.random.default_rng(10 + k)
+    differs = 0.0
+    for _ in range(4):
+        W, u = _random_delassus(rng, k, min(k, 3))
+        lam, u_post = _compliant(W, u, gamma, mass=True)
+        lam_o, u_o = oracle.compliant_impulses(W, u, gamma, mass=True)
+        np.testing.assert_allclose(u_post, u_o, rtol=0, atol=ORACLE_TOL * np.abs(u).max())
+        np.testing.assert_allclose(lam, lam_o, rtol=0, atol=ORACLE_TOL * np.abs(lam_o).max())
+        differs = max(differs, np.abs(u_post - _compliant(W, u, gamma)[1]).max())
+    assert differs > 1e-3

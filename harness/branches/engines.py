@@ -49,7 +49,7 @@ AFTER_MIN = 0.02  # but at least this long after it
 EXACT_DISTANCE = 1e-9
 FAR_DISTANCE = 0.5
 SAME_OUTCOME = 1e-9  # branches closer than this (dimensionless) are one outcome
-LAWS = ("moreau", "sequential", "compliant")
+LAWS = ("moreau", "sequential", "compliant", "compliant-mass")
 
 
 @dataclass

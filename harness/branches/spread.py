@@ -3,7 +3,7 @@
 The reference runs the scene under the paper's rule; where it stops
 `simultaneous_impact` (at t_u, contacts C touching) each branch runs the same scene
 under another impact law: `moreau`, `sequential` (the fastest approach first),
-`compliant` and, when
+`compliant`, `compliant-mass` and, when
 at most three contacts touch, `sequential` in every order of C.  Up to t_u every branch
 is the same exact run (the same compiled loop); after it they differ only by the law.
 The contacts of the impact are those touching at t_u and those the laws gave impulses
@@ -176,6 +176,7 @@ def branches_from(scene, t_end: float, paper_traj: Trajectory, progress=None) ->
         ("moreau", "moreau"),
         ("sequential", "sequential"),
         ("compliant", "compliant"),
+        ("compliant-mass", "compliant-mass"),
     ):
         if progress:
             progress(f"branches: {name}")

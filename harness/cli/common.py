@@ -236,7 +236,8 @@ def add_impact_law(p: argparse.ArgumentParser) -> None:
         help="impact law of simultaneous impacts in the reference: paper (the run ends "
         "simultaneous_impact), moreau (Moreau's frictionless law over every touching "
         "contact), sequential (single impacts, the fastest approach first) or "
-        "compliant (the rigid limit of a spring and dashpot at every touching contact) "
+        "compliant (the rigid limit of a spring and dashpot at every touching contact, one "
+        "stiffness everywhere; compliant-mass: stiffness in each contact's effective mass) "
         "(default: the scene's impact_law, else paper)",
     )
     p.add_argument(

@@ -30,8 +30,13 @@ of a pushing set decays to rest (`plastic`).
 
 The outcome does not depend on k (time scales as 1/√k).  In the units used here
 (W̃ = W / max Wᵢᵢ, u in units of max|u⁻|, Λ̃ = Λ max Wᵢᵢ / max|u⁻|, time in
-1/√(k max Wᵢᵢ)) the force is f̃ᵢ = κ dᵢ − c̃ᵢ ũᵢ with κ = 1, c̃ᵢ = 2ζ/√W̃ᵢᵢ (κ = 0,
+1/√(k max Wᵢᵢ)) the force is f̃ᵢ = κᵢ dᵢ − c̃ᵢ ũᵢ with κᵢ = 1, c̃ᵢ = 2ζ/√W̃ᵢᵢ (κᵢ = 0,
 c̃ᵢ = 1/√W̃ᵢᵢ for γ = 0).
+
+Stiffness in the effective mass (`compliant_mass_impulses`, the law `compliant-mass`):
+kᵢ = k max Wᵢᵢ / Wᵢᵢ, so that every contact alone oscillates at one frequency, the way
+per-constraint impedances scale (MuJoCo's solref time constant, Drake's SAP
+regularisation); κᵢ = 1/W̃ᵢᵢ, c̃ᵢ = 2ζ/W̃ᵢᵢ (γ = 0: κᵢ = 0, c̃ᵢ = 1/W̃ᵢᵢ).
 
 Exact per pushing set.  With a fixed set A of pushing contacts, z = (d, Λ̃, 1) obeys
 the linear system ż = B_A z with constant coefficients: ḋ = −ũ⁻ − W̃Λ̃, Λ̃ᵢ' = f̃ᵢ
@@ -109,13 +114,13 @@ def damping_ratio(gamma):
 def work_size(k):
     """Floats of scratch `compliant_impulses` needs for k contacts."""
     n = 2 * k + 1
-    return 4 * n * n + 5 * n + k
+    return 4 * n * n + 5 * n + 2 * k
 
 
 @hot
-def _force(W, u_pre, wbar, ubar, kappa, damp, z, k, i):
-    """f̃ᵢ = κ dᵢ − c̃ᵢ ũᵢ at state z (scaled units)."""
-    return kappa * z[i] - damp[i] * _velocity(W, u_pre, wbar, ubar, z, k, i)
+def _force(W, u_pre, wbar, ubar, spring, damp, z, k, i):
+    """f̃ᵢ = κᵢ dᵢ − c̃ᵢ ũᵢ at state z (scaled units)."""
+    return spring[i] * z[i] - damp[i] * _velocity(W, u_pre, wbar, ubar, z, k, i)
 
 
 @hot
@@ -128,7 +133,7 @@ def _velocity(W, u_pre, wbar, ubar, z, k, i):
 
 
 @hot
-def _build(W, u_pre, wbar, ubar, kappa, damp, active, k, B):
+def _build(W, u_pre, wbar, ubar, spring, damp, active, k, B):
     """B_A (n × n, row-major in B, n = 2k + 1) of the pushing set `active`; returns
     ‖B_A‖∞ over its linear block."""
     n = 2 * k + 1
@@ -144,11 +149,11 @@ def _build(W, u_pre, wbar, ubar, kappa, damp, active, k, B):
         norm = max(norm, row)
         if active[i]:
             r = (k + i) * n
-            B[r + i] = kappa
+            B[r + i] = spring[i]
             for j in range(k):
                 B[r + k + j] = -damp[i] * W[i, j] / wbar
             B[r + 2 * k] = -damp[i] * u_pre[i] / ubar
-            norm = max(norm, kappa + damp[i] * row)
+            norm = max(norm, spring[i] + damp[i] * row)
     return norm
 
 
@@ -199,20 +204,20 @@ def _propagator(B, h, n, P, T, S):
 
 
 @hot
-def _switches(W, u_pre, wbar, ubar, kappa, damp, active, z, k, i):
+def _switches(W, u_pre, wbar, ubar, spring, damp, active, z, k, i):
     """Whether contact i's pushing state at z differs from `active`: a pushing contact
     whose force is below −its roundoff, a free one with dᵢ > 0 and a force above it
     (the roundoff band keeps a contact that hovers at zero force from switching on
     noise)."""
-    f = _force(W, u_pre, wbar, ubar, kappa, damp, z, k, i)
-    tol = REST_ULPS * EPS * (kappa + damp[i])
+    f = _force(W, u_pre, wbar, ubar, spring, damp, z, k, i)
+    tol = REST_ULPS * EPS * (spring[i] + damp[i])
     if active[i]:
         return f < -tol
     return z[i] > 0.0 and f > tol
 
 
 @hot
-def _switch_time(W, u_pre, wbar, ubar, kappa, damp, active, B, z, h, k, i, zt, term, tmp):
+def _switch_time(W, u_pre, wbar, ubar, spring, damp, active, B, z, h, k, i, zt, term, tmp):
     """The first τ in (0, h] at which contact i switches (it does at h), to adjacent
     floats by bisection on z(τ) = exp(Bτ) z."""
     n = 2 * k + 1
@@ -222,7 +227,7 @@ def _switch_time(W, u_pre, wbar, ubar, kappa, damp, active, B, z, h, k, i, zt, t
         if mid <= lo or mid >= hi:
             break
         _propagate(B, mid, z, n, zt, term, tmp)
-        if _switches(W, u_pre, wbar, ubar, kappa, damp, active, zt, k, i):
+        if _switches(W, u_pre, wbar, ubar, spring, damp, active, zt, k, i):
             hi = mid
         else:
             lo = mid
@@ -271,28 +276,28 @@ def _scales(W, u_pre, k):
 
 
 @hot
-def _setup(W, u_pre, gamma, k, wbar, z, damp, active):
-    """The start: d = 0, Λ̃ = 0, the dampers c̃ᵢ, the contacts approaching pushing;
-    returns κ."""
+def _setup(W, u_pre, gamma, k, wbar, z, spring, damp, active, mass_scaled):
+    """The start: d = 0, Λ̃ = 0, the springs κᵢ and dampers c̃ᵢ (module docstring;
+    `mass_scaled`: kᵢ ∝ 1/Wᵢᵢ), the contacts approaching pushing."""
     zeta = damping_ratio(gamma)
-    kappa = 0.0 if gamma <= 0.0 else 1.0
     for i in range(k):
         s = math.sqrt(W[i, i] / wbar)
-        damp[i] = 1.0 / s if gamma <= 0.0 else 2.0 * zeta / s
+        scale = s * s if mass_scaled else s  # √(kᵢ/Wᵢᵢ) ∝ 1/scale
+        spring[i] = 0.0 if gamma <= 0.0 else (1.0 / (s * s) if mass_scaled else 1.0)
+        damp[i] = 1.0 / scale if gamma <= 0.0 else 2.0 * zeta / scale
         z[i] = 0.0
         z[k + i] = 0.0
         active[i] = 1 if u_pre[i] < 0.0 else 0
     z[2 * k] = 1.0
-    return kappa
 
 
 @hot
-def _first_switch(W, u_pre, wbar, ubar, kappa, damp, active, B, z, z1, h, k, zt, term, tmp):
+def _first_switch(W, u_pre, wbar, ubar, spring, damp, active, B, z, z1, h, k, zt, term, tmp):
     """The contact that switches first within the step z → z1 (−1: none) and when."""
     first, t_first = -1, math.inf
     for i in range(k):
-        if _switches(W, u_pre, wbar, ubar, kappa, damp, active, z1, k, i):
-            t = _switch_time(W, u_pre, wbar, ubar, kappa, damp, active, B, z, h, k, i,
+        if _switches(W, u_pre, wbar, ubar, spring, damp, active, z1, k, i):
+            t = _switch_time(W, u_pre, wbar, ubar, spring, damp, active, B, z, h, k, i,
                              zt, term, tmp)  # fmt: skip
             if t < t_first:
                 first, t_first = i, t
@@ -309,9 +314,22 @@ def _any_active(active, k):
 
 @hot
 def compliant_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
-    """The compliant law over k touching contacts (module docstring): impulses lam[:k]
-    and u_post[:k] = u⁻ + WΛ.  Returns SETTLED, NOT_SETTLED (a cap reached: Λ is the
-    state there), SINGULAR (a Wᵢᵢ ≤ 0) or TOO_MANY."""
+    """The compliant law over k touching contacts, the same stiffness at every contact
+    (module docstring): impulses lam[:k] and u_post[:k] = u⁻ + WΛ.  Returns SETTLED,
+    NOT_SETTLED (a cap reached: Λ is the state there), SINGULAR (a Wᵢᵢ ≤ 0) or
+    TOO_MANY."""
+    return _impulses(W, u_pre, gamma, k, lam, u_post, work, active, False)
+
+
+@hot
+def compliant_mass_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
+    """`compliant_impulses` with each contact's stiffness in its effective mass, kᵢ ∝
+    1/Wᵢᵢ (every contact alone oscillates at one frequency)."""
+    return _impulses(W, u_pre, gamma, k, lam, u_post, work, active, True)
+
+
+@hot
+def _impulses(W, u_pre, gamma, k, lam, u_post, work, active, mass_scaled):
     if k > MAX_COMPLIANT_CONTACTS:
         return TOO_MANY
     for i in range(k):
@@ -321,7 +339,7 @@ def compliant_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
     wbar, ubar, _ = _scales(W, u_pre, k)
     status = SETTLED
     if ubar > 0.0:
-        status = _run(W, u_pre, gamma, k, wbar, ubar, work, active)
+        status = _run(W, u_pre, gamma, k, wbar, ubar, work, active, mass_scaled)
         for i in range(k):
             lam[i] = work[4 * (2 * k + 1) ** 2 + k + i] * ubar / wbar
     for i in range(k):
@@ -333,7 +351,7 @@ def compliant_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
 
 
 @hot
-def _run(W, u_pre, gamma, k, wbar, ubar, work, active):
+def _run(W, u_pre, gamma, k, wbar, ubar, work, active, mass_scaled):
     """The impact in scaled units; the state z ends in work (see compliant_impulses)."""
     n = 2 * k + 1
     B, P, T, S = (
@@ -351,11 +369,12 @@ def _run(W, u_pre, gamma, k, wbar, ubar, work, active):
         work[o + 4 * n : o + 5 * n],
     )
     damp = work[o + 5 * n : o + 5 * n + k]
-    kappa = _setup(W, u_pre, gamma, k, wbar, z, damp, active)
+    spring = work[o + 5 * n + k : o + 5 * n + 2 * k]
+    _setup(W, u_pre, gamma, k, wbar, z, spring, damp, active, mass_scaled)
     tol = REST_ULPS * EPS
     stale, h, switches = True, 0.0, 0
     for _ in range(MAX_STEPS):
-        if kappa == 0.0 and _any_active(active, k):
+        if gamma <= 0.0 and _any_active(active, k):
             _resting(W, u_pre, wbar, ubar, active, z, k, tol)
         if not _any_active(active, k):
             i = _free_flight(W, u_pre, wbar, ubar, z, k, tol)
@@ -364,11 +383,11 @@ def _run(W, u_pre, gamma, k, wbar, ubar, work, active):
             active[i] = 1
             stale = True
         if stale:
-            h = STEP_NORM / _build(W, u_pre, wbar, ubar, kappa, damp, active, k, B)
+            h = STEP_NORM / _build(W, u_pre, wbar, ubar, spring, damp, active, k, B)
             _propagator(B, h, n, P, T, S)
             stale = False
         _matvec(P, z, n, z1)
-        i, t = _first_switch(W, u_pre, wbar, ubar, kappa, damp, active, B, z, z1, h, k,
+        i, t = _first_switch(W, u_pre, wbar, ubar, spring, damp, active, B, z, z1, h, k,
                              zt, term, tmp)  # fmt: skip
         if i < 0:
             for p in range(n):

@@ -4,10 +4,11 @@ impulses (reference.core.impact_laws), and (v, ω) += M⁻¹JᵀΛ.  Positions a
 (paper §2.3: impacts are instantaneous)."""
 
 from .chatter import completion_speed
-from .compliant import compliant_impulses
+from .compliant import compliant_impulses, compliant_mass_impulses
 from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
 from .impact_laws import (
     LAW_COMPLIANT,
+    LAW_COMPLIANT_MASS,
     LAW_MOREAU,
     LAW_SEQUENTIAL,
     NOT_SETTLED,
@@ -99,6 +100,9 @@ def _solve_law(
         )
     elif law == LAW_COMPLIANT:
         status = compliant_impulses(W, u_pre, gamma, k, lam, u_post, vec, active)
+        hits = 1
+    elif law == LAW_COMPLIANT_MASS:
+        status = compliant_mass_impulses(W, u_pre, gamma, k, lam, u_post, vec, active)
         hits = 1
     else:
         status, hits = NOT_SETTLED, 0

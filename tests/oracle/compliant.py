@@ -2,12 +2,12 @@
 tolerance with event location), independent of the core's closed form
 (reference.core.compliant).
 
-Each touching contact is a linear spring k and dashpot cᵢ in parallel, no adhesion:
-fᵢ = k dᵢ − cᵢ uᵢ while the contact pushes, 0 otherwise; ḋ = −u, Λ̇ = f, u = u⁻ + WΛ.
+Each touching contact is a linear spring kᵢ and dashpot cᵢ in parallel, no adhesion:
+fᵢ = kᵢ dᵢ − cᵢ uᵢ while the contact pushes, 0 otherwise; ḋ = −u, Λ̇ = f, u = u⁻ + WΛ.
 A pushing contact stops when its force reaches 0 (downwards), a free one starts when
 its penetration and its force are both positive (min(dᵢ, fᵢ) crosses 0 upwards).  The
-dashpot of contact i is cᵢ = 2ζ√(k/Wᵢᵢ) with ζ found here by integrating the single
-oscillator d̈ + 2ζḋ + d = 0 from d = 0, ḋ = 1 until d + 2ζḋ = 0 and solving
+dashpot of contact i is cᵢ = 2ζ√(kᵢ/Wᵢᵢ) (kᵢ = k, or kᵢ ∝ 1/Wᵢᵢ) with ζ found here by
+integrating the single oscillator d̈ + 2ζḋ + d = 0 from d = 0, ḋ = 1 until d + 2ζḋ = 0 and solving
 −ḋ(t_e) = γ for ζ with brentq (no closed form).  γ in (0, 1]."""
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def _events(W, u_pre, k_spring, c, active):
 
     def force(y, i):
         u = u_pre[i] + W[i] @ y[m:]
-        return k_spring * y[i] - c[i] * u
+        return k_spring[i] * y[i] - c[i] * u
 
     evs = []
     for i in range(m):
@@ -74,12 +74,15 @@ def _events(W, u_pre, k_spring, c, active):
     return evs
 
 
-def compliant_impulses(W, u_pre, gamma: float, k_spring: float = 1.0, max_switches: int = 500):
+def compliant_impulses(W, u_pre, gamma: float, mass: bool = False, max_switches: int = 500):
     """(Λ, u⁺) of the compliant law on Delassus matrix W and normal velocities u⁻ (the
-    outcome does not depend on k: integrated in units of max Wᵢᵢ and max|u⁻ᵢ|)."""
+    outcome does not depend on the stiffness's scale: integrated in units of max Wᵢᵢ and
+    max|u⁻ᵢ|, k = 1); `mass`: stiffness kᵢ = 1/Wᵢᵢ (in those units) instead of 1."""
     W0, u0 = np.asarray(W, dtype=float), np.asarray(u_pre, dtype=float)
     wmax, scale = float(np.diag(W0).max()), float(np.abs(u0).max())
-    lam = _scaled(W0 / wmax, u0 / scale, gamma, k_spring, max_switches) * scale / wmax
+    Ws = W0 / wmax
+    k_spring = 1.0 / np.diag(Ws) if mass else np.ones(len(u0))
+    lam = _scaled(Ws, u0 / scale, gamma, k_spring, max_switches) * scale / wmax
     return lam, u0 + W0 @ lam
 
 
@@ -88,7 +91,7 @@ def _scaled(W, u_pre, gamma, k_spring, max_switches):
     m = len(u_pre)
     c = 2.0 * damping_ratio(gamma) * np.sqrt(k_spring / np.diag(W))
     active = u_pre < 0.0
-    period = 2.0 * np.pi / np.sqrt(k_spring * np.diag(W).min())
+    period = 2.0 * np.pi / np.sqrt((k_spring * np.diag(W)).min())
     y = np.zeros(2 * m)
     for _ in range(max_switches):
         u = u_pre + W @ y[m:]
