@@ -28,7 +28,12 @@ LANDINGS = {
                            "a flat triangle landing with vertex 0 separating"),
     "landing-three-bumps": (64, "three_point", (0, 0, 0), (0.05, 0.03, -0.8),
                             (0.2, -0.1, 0.5), "a disk landing flat on three bumps"),
+    "landing-offset-bumps": (64, "three_point", (0, 0, 0), (0.05, 0.03, -0.8),
+                             (0.2, -0.1, 0.5), "a disk landing flat on three bumps, its "
+                             "centre off theirs: unequal effective masses"),
 }  # fmt: skip
+# the disk's centre off the bumps' centre (x, y), so that the bumps' Wᵢᵢ differ
+_OFFSET = {"landing-offset-bumps": (0.25, 0.1)}
 
 
 def landing(name: str, gamma: float = 0.5, gyration: float = 0.5, t_end: float = 1.0) -> Scene:
@@ -37,6 +42,7 @@ def landing(name: str, gamma: float = 0.5, gyration: float = 0.5, t_end: float =
     y = np.zeros(13)
     y[L.QUATERNION] = qt.from_rotation_vector(np.asarray(rot, dtype=float))
     y[L.VELOCITY], y[L.ANGULAR_VELOCITY] = v, w
+    y[L.X], y[L.Y] = _OFFSET.get(name, (0.0, 0.0))
     base = Scene(name=name, description=text, body=Body(n=n, gyration=gyration),
                  ground=Ground(kind=ground), restitution=gamma,
                  initial=InitialState((0, 0, 0), (0, 0, 0), (0, 0, 0), (0, 0, 0)), gravity=1.0,
