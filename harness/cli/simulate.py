@@ -81,10 +81,11 @@ def check_outputs(args, paths) -> None:
 
 
 def run(args) -> int:
-    from ..simulators import check_engine, check_run, run_simulator
+    from ..simulators import check_engine, check_law_options, check_run, run_simulator
     from ..text import format_simulate
 
     check_engine(args.engine)
+    check_law_options(args.engine, args.impact_law, args.simultaneity_window)
     scene = load_scene_arg(args)
     check_run(args.engine, scene, args.dt, args.t_end, args.max_steps)
     check_outputs(args, planned_outputs(args))
