@@ -105,7 +105,7 @@ def run(args) -> int:
     if interrupted:
         note("harness: interrupted; the summary covers the part computed, no file written")
     else:
-        write_outputs(args, traj, scene)
+        write_or_say(args, traj, scene)
     emit(summary_with_kinds(traj, scene), args.json, format_simulate(traj))
     return INTERRUPTED if interrupted else 0
 
@@ -121,6 +121,21 @@ def summary_with_kinds(traj, scene) -> dict:
         for row in doc["impacts"]:
             row["kind"] = names[row["contact"]]
     return doc
+
+
+def write_or_say(args, traj, scene) -> None:
+    """`write_outputs`; memory exhausted while writing is OutputError (exit 2, one line)
+    that keeps the run's own status and message, with nothing written (the writers are
+    atomic: harness.outputs)."""
+    from ..outputs import OutputError
+
+    try:
+        write_outputs(args, traj, scene)
+    except MemoryError as exc:  # pyarrow's ArrowMemoryError too
+        raise OutputError(
+            f"out of memory while writing the outputs ({type(exc).__name__}); nothing "
+            f"written; the run itself ended {traj.status.value}: {traj.message}"
+        ) from None
 
 
 def write_outputs(args, traj, scene) -> None:
