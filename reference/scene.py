@@ -383,11 +383,12 @@ def check_impact_law(law: Any) -> str:
     return law
 
 
-def check_window(window: float) -> float:
+def check_window(window: Any) -> float:
     """A simultaneity window: a finite time >= 0 (0: strictly sequential)."""
-    if not (math.isfinite(window) and 0.0 <= window <= DIMENSION_RANGE[1]):
+    w = _number("simultaneity_window", window)
+    if not 0.0 <= w <= DIMENSION_RANGE[1]:
         raise SceneError(f"simultaneity_window must be a finite time >= 0, got {window!r}")
-    return float(window)
+    return w
 
 
 def _parse_body(b: dict) -> Body:
