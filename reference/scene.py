@@ -647,7 +647,7 @@ def check_window_bound(scene: Scene, window: float) -> float:
     into one impact, which is no longer simultaneity, and the law's sequential work
     grows without bound (measured on triangle-chatter under `sequential`: 3e9 ends in
     0.3 s, 1e10 does not end)."""
-    limit = MAX_WINDOW_TIME_UNITS * scene.body.radius / window_speed_unit(scene)
+    limit = MAX_WINDOW_TIME_UNITS * time_unit(scene)
     if window > limit:
         raise SceneError(
             f"simultaneity_window must be at most the motion's time unit a/V = {limit:.3g} "
@@ -681,6 +681,13 @@ def window_speed_unit(scene: Scene) -> float:
     shrink with the speeds, are never merged).  Without gravity: velocity_unit."""
     g, a = scene.gravity, scene.body.radius
     return math.sqrt(g * a) if g > 0 else velocity_unit(scene)
+
+
+def time_unit(scene: Scene) -> float:
+    """a/V (V = window_speed_unit): √(a/g), or t_end without gravity; the time of a
+    bounce at the speed unit, the scale on which the window and a run's progress are
+    judged."""
+    return scene.body.radius / window_speed_unit(scene)
 
 
 def velocity_unit(scene: Scene) -> float:
