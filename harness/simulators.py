@@ -189,8 +189,9 @@ def check_law_options(engine: str, impact_law: str | None, window: float | None)
         if value is not None
     ]
     if given and engine not in LAW_ENGINES:
+        verb = "applies" if len(given) == 1 else "apply"
         raise SceneError(
-            f"{' and '.join(given)} apply to the {' and '.join(LAW_ENGINES)} engines only; "
+            f"{' and '.join(given)} {verb} to the {' and '.join(LAW_ENGINES)} engines only; "
             f"{engine} resolves its contacts with its own solver"
         )
 

@@ -293,7 +293,7 @@ def test_law_options_for_an_engine_that_does_not_read_them_are_refused(argv, cap
     argv = [str(tmp_path / a) if a == "x" else a for a in argv]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "apply to the reference and linear engines only" in err[0], err
+    assert len(err) == 1 and "applies to the reference and linear engines only" in err[0], err
     assert not (tmp_path / "x").exists()
 
 

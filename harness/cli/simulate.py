@@ -31,8 +31,8 @@ def register(sub) -> None:
         help="one run of one simulator",
         description="One run of one simulator on one scene.  Prints the run's summary "
         "(status, impacts, energy, final state).  Exit status 0 done (whatever the "
-        "physics), 2 bad input, 130 stopped by Ctrl-C (the summary of the part computed "
-        "is printed, no file is written).",
+        "physics), 2 bad input, 130 stopped by Ctrl-C, 143 by SIGTERM (the summary of the "
+        "part computed is printed, no file is written).",
     )
     add_scene(s)
     add_engine(s)
