@@ -2,12 +2,16 @@
 
 `harness simulate/compare/...` (harness.simulators.check_run), `reference.simulate`,
 `reference.linear.simulate.simulate_linear` and `harness.simulators.run_simulator` all
-call `run_horizon` before any work: the run's t_end is checked like a scene file's
-`[run] t_end` (a finite number in DIMENSION_RANGE: NaN, 0, negative and out-of-range
-values raise SceneError) together with the scene (`Scene.with_run`: the speed group the
-t_end implies).  The options of the two exact simulators are checked here too
-(`check_reference_options`, `check_linear_options`): a NaN tolerance or a zero work
-budget would otherwise make a run that never returns or divides by zero.
+call `run_horizon` before any work: the scene, however it was built (a file,
+`dataclasses.replace`, the constructors), passes `reference.scene.check_scene`, every
+field's type and range as a scene file's key; the run's t_end is checked like a scene
+file's `[run] t_end` (a finite number in DIMENSION_RANGE: NaN, 0, negative and
+out-of-range values raise SceneError) together with the scene (`Scene.with_run`: the
+speed group the t_end implies).  The options of the two exact simulators are checked
+here too (`check_reference_options`, `check_linear_options`): their types, their ranges
+and the sequential law's order, since a NaN tolerance, a zero work budget or an order
+naming no contact would otherwise make a run that never returns, divides by zero or
+silently ignores the order.
 """
 
 from __future__ import annotations

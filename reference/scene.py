@@ -16,7 +16,10 @@ alone when g = 0), with the velocity unit U = a/τ = max(√(g a), a/t_end):
   1e±12 of 1 the smaller keeps four of its sixteen digits;
 - 2 ≤ n ≤ MAX_VERTICES: beyond, the polygon differs from its circle by
   a (1 − cos π/n) < 5e-12 a; the per-vertex arrays cost O(n) memory;
-- bump_radius / a in [MIN_BUMP_RADIUS, 1);
+- bump_radius / a in [MIN_BUMP_RADIUS, 1); listed bumps at least MIN_BUMP_SPACING a
+  apart in the plane (coincident bumps make a singular impact problem);
+- simultaneity_window at most MAX_WINDOW_TIME_UNITS time units a/V = √(a/g)
+  (check_window_bound: a wider window merges a contact's later bounces);
 - speed group (|v| + |ω| a) / U ≤ MAX_SPEED, i.e. v²/(g a) and ω² a/g ≤ 1e6: the
   reference's tolerances follow the body's velocity scale V (velocity noise 64 ε V,
   chatter completed below 1e-6 V), and on flat ground the horizontal velocity and the
