@@ -84,3 +84,4 @@ def handled() -> Iterator[None]:
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        _received.clear()  # a later command, or API use in this process, starts afresh

@@ -145,3 +145,17 @@ def test_no_file_is_moved_into_place_after_a_swallowed_signal(tmp_path, monkeypa
     with pytest.raises(signals.Terminated):
         write_text(tmp_path / "late.txt", "after the signal")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_signal_is_forgotten_once_its_command_ended(toy, tmp_path):
+    """After a command that was terminated, writing a file in the same process works."""
+    from harness.outputs import write_text
+
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGTERM))
+    timer.start()
+    try:
+        code = main(["simulate", "triangle-chatter", "--engine", "toy", "--dt", "1e-6"])
+    finally:
+        timer.cancel()
+    assert code == signals.EXIT_TERMINATED and signals.received() is None
+    assert write_text(tmp_path / "after.txt", "fine").read_text() == "fine"
