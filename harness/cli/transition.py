@@ -36,7 +36,10 @@ def register(sub) -> None:
         "three bumps of height Delta, in the paper's units (d = 0.1 m, g = 9.81), followed "
         "to the end: energy against the time to the singularity with the regimes (rim "
         "only, mixed, bumps only), the local exponent c of each, the tilt at which the "
-        "bumps take over against Delta/a, the time in each regime.",
+        "bumps take over against Delta/a, the time in each regime.  The reference run ends "
+        "failed ('stalled at t = ...') when three returns of its loop in a row advance t by "
+        "less than one roundoff unit of the motion's time scale sqrt(a/g) per step (the "
+        "bumpy ground's contact phases can creep, e.g. at restitution 0).",
     )
     t.add_argument(
         "scene",
