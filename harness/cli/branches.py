@@ -76,7 +76,7 @@ def run_spread(args) -> int:
     scene = load_scene_arg(args)
     check_run("reference", scene, None, args.t_end)
     if args.plot:
-        check_writable(args.plot, force=args.force, inputs=scene_inputs(args))
+        check_writable(args.plot, args.force, scene_inputs(args), what="--plot", suffixes=(".png",))
     spread = branches(scene, args.t_end, progress=log)
     doc = attach(spread.to_dict(), args)
     if args.plot:
@@ -105,7 +105,7 @@ def run_engines(args) -> int:
         check_run("reference", scene, None, args.t_end)
     if args.plot:
         inputs = [] if args.suite else scene_inputs(args)
-        check_writable(args.plot, force=args.force, inputs=inputs)
+        check_writable(args.plot, args.force, inputs, what="--plot", suffixes=(".png",))
     studies = [study(s, args.engine, dts, args.t_end, progress=log) for s in scenes]
     doc = attach({"command": "branches", "mode": "engines",
                   "studies": [s.to_dict() for s in studies]}, args)  # fmt: skip
