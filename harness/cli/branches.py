@@ -28,12 +28,12 @@ def register(sub) -> None:
         help="continue the reference past its first undecidable state under every law",
         description="Run the reference under the paper's rule to its first undecidable "
         "state (simultaneous_impact), then continue the same scene under each impact law "
-        "(moreau, sequential, compliant, and the sequential law in each order of the "
-        "touching contacts when at most three touch); print the spread of the branches: "
-        "energy after the impact, the next impacts, final status, t_f and the exponent c. "
-        "With --engine: start each engine just before that state, run it through the "
-        "impact and print its distance to every branch at each dt and the law it follows "
-        "(docs/laws.md).",
+        "(moreau, sequential, compliant, compliant-mass, and the sequential law in each "
+        "order of the touching contacts when at most three touch); print the spread of "
+        "the branches: energy after the impact, the next impacts, final status, t_f and "
+        "the exponent c. With --engine: start each engine just before that state, run it "
+        "through the impact and print its distance to every branch at each dt and the "
+        "law it follows (docs/laws.md).",
     )
     b.add_argument("scene", nargs="?", help="a scene file (TOML) or the name of a built-in "
                    "scene (not with --suite)")  # fmt: skip
