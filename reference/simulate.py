@@ -22,7 +22,7 @@ from .checks import check_reference_options, run_horizon
 from .core import records as R
 from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
 from .core.law_event import NO_PROGRESS
-from .core.laws import LAW_PAPER, law_code
+from .core.laws import LAW_PAPER, law_code, law_of, work_floats
 from .core.records import (
     N_ACCUMULATIONS,
     N_IMPACTS,
@@ -39,6 +39,7 @@ from .scene import (
     Scene,
     check_impact_law,
     check_window,
+    check_window_bound,
     reference_window,
     scene_from_dict,
     window_speed_unit,
@@ -154,7 +155,15 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["window_per_speed"] = reference_window(scene) / window_speed_unit(scene)
     rec["floor_depth"] = scene.ground.floor_below(scene.body)
     rec["law"] = law_code(scene.impact_law)
+    rec["law_separating"] = law_of(rec["law"][0]).separating
     return rec
+
+
+def law_arrays(scene: Scene, opts: ReferenceOptions) -> tuple:
+    """The scratch of a simultaneous impact under the scene's law (records.new_law_arrays)."""
+    k = law_contacts(scene)
+    work = work_floats(law_of(law_code(scene.impact_law)), k)
+    return R.new_law_arrays(k, opts.sequential_order or (), work)
 
 
 def law_contacts(scene: Scene) -> int:
@@ -211,7 +220,7 @@ def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
         accumulations=np.empty(MIN_ROWS),
         contact_ints=contact_ints,
         contact_floats=contact_floats,
-        law_arrays=R.new_law_arrays(law_contacts(scene), opts.sequential_order or ()),
+        law_arrays=law_arrays(scene, opts),
         full_rows=output_rows(scene.run.max_impacts, t_end, opts),
     )
 
@@ -249,7 +258,7 @@ def simulate(
     scene = as_scene(scene)
     opts = ReferenceOptions() if options is None else options
     t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
-    check_reference_options(opts)
+    check_reference_options(opts, scene)
     law, window = impact_law_of(scene, opts)
     if (law, window) != (scene.impact_law, scene.simultaneity_window):
         scene = scene.with_impact_law(law, window)  # the options' choice, for the core
@@ -273,7 +282,7 @@ def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
         if opts.simultaneity_window is not None
         else reference_window(scene, law)
     )
-    return check_impact_law(law), check_window(window)
+    return check_impact_law(law), check_window_bound(scene, check_window(window))
 
 
 # A rough cost of compiling the loop just in time on a 2-core machine (measured).

@@ -1,7 +1,8 @@
 """Runs of the exact reference under the impact laws of simultaneous impacts
-(reference.continuation): scenes that start on 2, 3 and 6 contacts against the
-enumerated LCP (tests/oracle/lcp.py), the flat drop's bounces completed in closed form,
-the law named in every output, and the scene key and options."""
+(reference.core.law_event, inside the compiled loop): scenes that start on 2, 3 and 6
+contacts against the enumerated LCP (tests/oracle/lcp.py), the flat drop's bounces
+listed and completed in closed form, the law named in every output, and the scene key
+and options."""
 
 from __future__ import annotations
 
@@ -175,7 +176,7 @@ def test_every_output_names_the_law(tmp_path, capsys):
     assert main(["branches", str(path), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     names = [b["branch"] for b in doc["branches"]]
-    assert names == ["paper", "moreau", "sequential"]  # six contacts: no orders
+    assert names == ["paper", "moreau", "sequential", "compliant", "compliant-mass"]  # no orders
     assert doc["undecidable"]["t"] == pytest.approx(1.0)
     assert doc["undecidable"]["contacts"] == list(range(6))
     moreau = doc["branches"][1]

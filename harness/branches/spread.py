@@ -102,16 +102,18 @@ def spread_of(branches: list[Branch]) -> dict[str, Any]:
     }
 
 
-def touching_contacts(scene, y: np.ndarray) -> np.ndarray:
+def touching_contacts(scene, y: np.ndarray, separating: bool = False) -> np.ndarray:
     """Contacts touching the ground at state y and not separating: gap ≤ TOUCH_ULPS ε
     (|z| + a), normal velocity ≤ its roundoff (the rule of the loop's simultaneous
-    impacts, reference.core.law_event)."""
+    impacts, reference.core.law_event); `separating`: the touching ones that separate
+    too (the laws that take them, `ImpactLaw.separating`)."""
     gap, vn = contact_kinematics(y, scene.contacts)
     gap, vn = gap[0], vn[0]
     a = scene.body.radius
     gap_tol = TOUCH_ULPS * EPS * (abs(y[2]) + a)
     v_scale = np.linalg.norm(y[7:10]) + a * np.linalg.norm(y[10:13])
-    return np.flatnonzero((gap <= gap_tol) & (vn <= RATE_NOISE_ULPS * EPS * v_scale))
+    at_rest = vn <= RATE_NOISE_ULPS * EPS * v_scale
+    return np.flatnonzero((gap <= gap_tol) & (at_rest | separating))
 
 
 def ordered_runs(contacts: list[int]) -> list[tuple[str, str, tuple[int, ...]]]:

@@ -63,7 +63,7 @@ def law_event(state, model, pts, opts, stats, out, ws, cs, named, n_named):
     y = state.y
     K = cs.law_mats.shape[1]  # the scratch's contacts (ContactLists.law_mats)
     contacts = cs.law_ints[:K]
-    k = touching_set(y, model, pts, named, n_named, contacts)
+    k = touching_set(y, model, pts, named, n_named, contacts, model.law_separating)
     if k < 0:
         return _undecided(state, TOO_MANY, named, n_named)
     W, chol = cs.law_mats[:K], cs.law_mats[K:]
@@ -152,10 +152,11 @@ def _named(contacts, m, c):
 
 
 @hot
-def touching_set(y, model, pts, named, n_named, contacts):
+def touching_set(y, model, pts, named, n_named, contacts, separating):
     """contacts[:m] = named[:n_named] (without repeats) and every other contact touching
-    (gap ≤ TOUCH_ULPS ε (|z| + a)) and not separating (normal velocity ≤ its roundoff);
-    returns m, or −1 when they do not fit in `contacts`."""
+    (gap ≤ TOUCH_ULPS ε (|z| + a)) and not separating (normal velocity ≤ its roundoff;
+    `separating`: separating ones too, for a law whose other contacts can push them
+    back); returns m, or −1 when they do not fit in `contacts`."""
     cap = contacts.shape[0]
     m = 0
     for i in range(n_named):
@@ -172,7 +173,7 @@ def touching_set(y, model, pts, named, n_named, contacts):
         f = contact_frame(y, kind, pts, c)
         if f.gap > gap_tol or _named(contacts, n_named_set, c):
             continue
-        if normal_velocity(y, f, kind) <= v_tol:
+        if separating or normal_velocity(y, f, kind) <= v_tol:
             if m >= cap:
                 return -1
             contacts[m] = c

@@ -24,8 +24,15 @@ CLI read it without loading numba.
 from collections import namedtuple
 
 # A law: name, integer code (model.law), help text, "module:function" of its compiled
-# impulse function under reference.core (None: the paper's rule, the loop's events).
-ImpactLaw = namedtuple("ImpactLaw", ["name", "code", "help", "impulses"])
+# impulse function under reference.core (None: the paper's rule, the loop's events);
+# optional: `separating` (the impact takes the touching contacts that separate too: the
+# others can push them back) and `work_size` ("module:function" k → floats of scratch
+# `work.vec` it needs; None: 2k).
+ImpactLaw = namedtuple(
+    "ImpactLaw",
+    ["name", "code", "help", "impulses", "separating", "work_size"],
+    defaults=(False, None),
+)
 
 # the law functions' arguments, in order
 LAW_ARGUMENTS = ("W", "u_pre", "gamma", "k", "lam", "u_post", "work")
@@ -45,6 +52,16 @@ LAWS = (
         "sequential", 2,
         "single impacts one contact at a time, the fastest approach first",
         "impact_laws:sequential_law",
+    ),
+    ImpactLaw(
+        "compliant", 3,
+        "the rigid limit of a spring and dashpot at every touching contact, one stiffness",
+        "compliant:compliant_law", separating=True, work_size="compliant:work_size",
+    ),
+    ImpactLaw(
+        "compliant-mass", 4,
+        "compliant, each contact's stiffness in its effective mass",
+        "compliant:compliant_mass_law", separating=True, work_size="compliant:work_size",
     ),
 )  # fmt: skip
 
@@ -73,6 +90,27 @@ def law_help(laws=LAWS):
 def resolving_laws(laws=LAWS):
     """The laws that resolve a simultaneous impact (every one with a function)."""
     return tuple(law for law in laws if law.impulses is not None)
+
+
+def law_of(code, laws=LAWS):
+    """The registry entry of the law with integer code `code`."""
+    for law in laws:
+        if law.code == code:
+            return law
+    raise KeyError(code)
+
+
+def work_floats(law, k):
+    """Floats of `work.vec` scratch the law needs for k contacts (at least 2k)."""
+    if law.work_size is None:
+        return 2 * k
+    if callable(law.work_size):
+        return max(2 * k, int(law.work_size(k)))
+    import importlib
+
+    module, name = law.work_size.split(":")
+    size = getattr(importlib.import_module(f"reference.core.{module}"), name)(k)
+    return max(2 * k, int(size))
 
 
 def with_law(law, laws=LAWS):

@@ -82,6 +82,7 @@ MODEL = np.dtype(
         ("floor_depth", np.float64),  # d: the floor plane z = −d, a model limit of a ground
         # without rim vertices (reference.core.floor); inf: none
         ("law", np.int64),  # the impact law's code (reference.core.laws)
+        ("law_separating", np.bool_),  # its impact takes separating contacts too
     ]
 )
 
@@ -244,13 +245,14 @@ def new_contact_arrays(n):
     )
 
 
-def new_law_arrays(k, order=()):
-    """The float (2k, k), float (5k,) and int (3k + len(order),) arrays of a simultaneous
-    impact of up to k contacts under an impact law (workspace.ContactLists), the
-    sequential law's order of contacts after the int rows."""
+def new_law_arrays(k, order=(), work=None):
+    """The float (2k, k), float (3k + work,) and int (3k + len(order),) arrays of a
+    simultaneous impact of up to k contacts under an impact law (workspace.ContactLists):
+    `work` floats of the law's scratch (laws.work_floats; None: 2k), the sequential
+    law's order of contacts after the int rows."""
     ints = np.zeros(3 * k + len(order), dtype=np.int64)
     ints[3 * k :] = order
-    return np.zeros((2 * k, k)), np.zeros(5 * k), ints
+    return np.zeros((2 * k, k)), np.zeros(3 * k + (2 * k if work is None else work)), ints
 
 
 # Columns of the impact rows the loop writes.

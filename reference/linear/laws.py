@@ -49,7 +49,7 @@ from ..core.impact_laws import (
     TOO_MANY,
 )
 from ..core.law_event import LAW_MAX_REPEATS as MAX_RESTARTS_AT_ONE_TIME
-from ..core.laws import LAW_PAPER, LAWS, law_code, resolving_laws
+from ..core.laws import LAW_PAPER, LAWS, law_code, law_of, resolving_laws, work_floats
 from ..core.records import LawWork
 from ..core.tolerances import EPS
 from ..trajectory import Status
@@ -79,7 +79,8 @@ def law_impulses(W, u_pre, gamma, law: int):
     W = np.ascontiguousarray(W, dtype=float)
     u_pre = np.ascontiguousarray(u_pre, dtype=float)
     lam, u_post = np.zeros(k), np.zeros(k)
-    work = LawWork(np.zeros((k, k)), np.zeros(2 * k), np.zeros(k, dtype=np.int64),
+    vec = np.zeros(work_floats(law_of(law), k))
+    work = LawWork(np.zeros((k, k)), vec, np.zeros(k, dtype=np.int64),
                    np.zeros(0, dtype=np.int64), 0, MAX_SEQUENTIAL_IMPACTS)  # fmt: skip
     status, hits = solve_law(law, W, u_pre, float(gamma), k, lam, u_post, work)
     return int(status), lam, u_post, int(hits)
