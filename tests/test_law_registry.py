@@ -24,8 +24,10 @@ ROOT = Path(__file__).resolve().parent.parent
 SECTION = "### Adding an impact law"
 
 
-def _work(k):
-    return LawWork(np.zeros((k, k)), np.zeros(2 * k), np.zeros(k, dtype=np.int64),
+def _work(k, law=None):
+    """The law's scratch for k contacts (its entry's work_size; 2k floats by default)."""
+    vec = np.zeros(laws.work_floats(law, k) if law is not None else 2 * k)
+    return LawWork(np.zeros((k, k)), vec, np.zeros(k, dtype=np.int64),
                    np.zeros(0, dtype=np.int64), 0, 1000)  # fmt: skip
 
 
@@ -75,8 +77,8 @@ def test_the_dispatch_reaches_each_registered_law_by_its_code():
         fn = law_function(law)
         lam, u_post = np.zeros(3), np.zeros(3)
         lam2, u_post2 = np.zeros(3), np.zeros(3)
-        assert solve_law(law.code, W, u, 0.5, 3, lam, u_post, _work(3))[0] == SETTLED
-        assert fn(W, u, 0.5, 3, lam2, u_post2, _work(3))[0] == SETTLED
+        assert solve_law(law.code, W, u, 0.5, 3, lam, u_post, _work(3, law))[0] == SETTLED
+        assert fn(W, u, 0.5, 3, lam2, u_post2, _work(3, law))[0] == SETTLED
         assert np.array_equal(lam, lam2) and np.array_equal(u_post, u_post2)
 
 
