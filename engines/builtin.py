@@ -2,7 +2,9 @@
 in pyproject.toml like any third-party engine; docs/engines.md).
 
 This module imports nothing heavy: each callable imports its engine when it runs, so that
-listing the engines or running the reference never imports MuJoCo, PyBullet or Drake.
+listing the engines or running the reference never imports MuJoCo, PyBullet, Drake, DART
+or JAX.  MuJoCo and PyBullet are core dependencies; every other engine names the pip extra
+that installs its library (`extra`).
 """
 
 from __future__ import annotations
@@ -25,13 +27,24 @@ LINEAR_GROUNDS = ("flat", "three_point")
 
 
 def _profile(
-    module: str, function: str, profile: str, library: str, doc: str, progress: bool = False
+    module: str,
+    function: str,
+    profile: str,
+    library: str,
+    doc: str,
+    progress: bool = False,
+    extra: str | None = None,
 ) -> Callable:
     """An entry point that runs `module.function(scene, dt, t_end=…, profile=…)` (and
-    passes `progress` on when the adapter reports it)."""
+    passes `progress` on when the adapter reports it); `extra`: the pip extra that installs
+    `library` (None for the core engines)."""
 
     @engine_entry(
-        fixed_step=True, library=library, max_vertices=MAX_VERTICES, reports_progress=progress
+        fixed_step=True,
+        library=library,
+        max_vertices=MAX_VERTICES,
+        reports_progress=progress,
+        extra=extra,
     )
     def simulate(
         scene: Scene, *, dt: float, t_end: float | None = None, progress=None
@@ -94,7 +107,12 @@ pybullet_default = _profile(
     progress=True,
 )
 drake = _profile(
-    "engines.drake", "simulate_drake", "sap", "drake", "Drake, discrete plant with the SAP solver"
+    "engines.drake",
+    "simulate_drake",
+    "sap",
+    "drake",
+    "Drake, discrete plant with the SAP solver",
+    extra="drake",
 )
 drake_continuous = _profile(
     "engines.drake",
@@ -102,4 +120,5 @@ drake_continuous = _profile(
     "continuous",
     "drake",
     "Drake, continuous plant, error-controlled RK3 (dt = its maximum step)",
+    extra="drake",
 )

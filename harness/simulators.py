@@ -51,6 +51,29 @@ class EngineLoadError(SceneError):
     """An engine that is missing or cannot be loaded (exit status 2)."""
 
 
+class EngineNotInstalled(EngineLoadError):
+    """A registered engine whose physics library is not installed: its pip extra was
+    not chosen (exit status 2 when it is asked to run; `harness engines` lists it)."""
+
+
+def install_hint(extra: str) -> str:
+    """The command that installs an extra of this package."""
+    return f"pip install 'euler-disk-harness[{extra}]'"
+
+
+def _check_library(name: str, obj: Callable) -> None:
+    """EngineNotInstalled when the engine names the extra of a library that is missing."""
+    library, extra = attribute(obj, "library"), attribute(obj, "extra")
+    if library is None or extra is None:
+        return
+    try:
+        metadata.version(library)
+    except metadata.PackageNotFoundError:
+        raise EngineNotInstalled(
+            f"engine {name!r} needs {library}, which is not installed: {install_hint(extra)}"
+        ) from None
+
+
 @functools.cache
 def _discovered() -> dict[str, EngineInfo]:
     found: dict[str, EngineInfo] = {}
@@ -107,9 +130,18 @@ def engine_names() -> list[str]:
     return first + sorted(names - set(first))
 
 
-def load_engine(name: str) -> Callable:
-    """The engine's `simulate` callable (EngineLoadError if missing or broken)."""
+def entry_point(name: str) -> Callable:
+    """The engine's entry point, loaded, whether or not its library is installed
+    (EngineLoadError if it is not registered or broken)."""
     return _loaded(name)
+
+
+def load_engine(name: str) -> Callable:
+    """The engine's `simulate` callable (EngineLoadError if missing or broken,
+    EngineNotInstalled when its library, from a pip extra, is missing)."""
+    obj = _loaded(name)
+    _check_library(name, obj)
+    return obj
 
 
 def is_fixed_step(name: str) -> bool:
