@@ -34,6 +34,7 @@ def _profile(
     doc: str,
     progress: bool = False,
     extra: str | None = None,
+    ground_kinds: tuple[str, ...] | None = None,
 ) -> Callable:
     """An entry point that runs `module.function(scene, dt, t_end=…, profile=…)` (and
     passes `progress` on when the adapter reports it); `extra`: the pip extra that installs
@@ -45,6 +46,7 @@ def _profile(
         max_vertices=MAX_VERTICES,
         reports_progress=progress,
         extra=extra,
+        ground_kinds=ground_kinds,
     )
     def simulate(
         scene: Scene, *, dt: float, t_end: float | None = None, progress=None
@@ -121,4 +123,26 @@ drake_continuous = _profile(
     "drake",
     "Drake, continuous plant, error-controlled RK3 (dt = its maximum step)",
     extra="drake",
+)
+# DART's grounds (engines.dart.GROUND_KINDS: bumpy needs per-shape collision masks).
+DART_GROUNDS = ("flat", "three_point")
+dart = _profile(
+    "engines.dart",
+    "simulate_dart",
+    "tuned",
+    "dartpy",
+    "DART, LCP contact: restitution gamma, units scaled past its rebound cut-off",
+    progress=True,
+    extra="dart",
+    ground_kinds=DART_GROUNDS,
+)
+dart_default = _profile(
+    "engines.dart",
+    "simulate_dart",
+    "default",
+    "dartpy",
+    "DART, defaults + restitution sqrt(gamma) per shape (cut-off 0.1)",
+    progress=True,
+    extra="dart",
+    ground_kinds=DART_GROUNDS,
 )
