@@ -146,3 +146,28 @@ dart_default = _profile(
     extra="dart",
     ground_kinds=DART_GROUNDS,
 )
+
+
+def _mjx(precision: str, name: str, doc: str) -> Callable:
+    """An MJX entry point (float64 or float32) that also offers `simulate_batch`."""
+
+    @engine_entry(fixed_step=True, library="mujoco-mjx", max_vertices=MAX_VERTICES, extra="mjx")
+    def simulate(scene: Scene, *, dt: float, t_end: float | None = None, progress=None):
+        from engines.mjx import simulate_mjx
+
+        return simulate_mjx(scene, dt, t_end=t_end, precision=precision, progress=progress)
+
+    def simulate_batch(scenes, *, dt: float, t_end: float | None = None):
+        from engines.mjx import simulate_mjx_batch
+
+        return simulate_mjx_batch(scenes, dt=dt, t_end=t_end, precision=precision)
+
+    simulate.reports_progress = True
+    simulate.simulate_batch = simulate_batch
+    simulate.__doc__ = doc
+    simulate.__qualname__ = simulate.__name__ = name
+    return simulate
+
+
+mjx = _mjx("float64", "mjx", "MJX (MuJoCo XLA) on JAX, float64: the mujoco model, diagexact off")
+mjx_f32 = _mjx("float32", "mjx_f32", "MJX (MuJoCo XLA) on JAX, float32: the mujoco model")
