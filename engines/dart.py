@@ -142,7 +142,8 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> DartSettings:
             1.0,
             "fcl",
             False,
-            f"restitution sqrt(gamma) on every shape; rebound cut-off {BOUNCING_VELOCITY_THRESHOLD}",
+            "restitution sqrt(gamma) on every shape; "
+            f"rebound cut-off {BOUNCING_VELOCITY_THRESHOLD}",
         )
     raise ValueError(f"unknown DART profile {profile!r}; choose from {', '.join(PROFILES)}")
 

@@ -282,7 +282,9 @@ def simulate_mjx_batch(
         t_run = sc.run.t_end if t_end is None else float(t_end)
         groups.setdefault((_model_key(sc), t_run), []).append(i)
     for (_, t_run), idx in groups.items():
-        for i, traj in zip(idx, _run_group([scenes[i] for i in idx], dt, t_run, precision)):
+        for i, traj in zip(
+            idx, _run_group([scenes[i] for i in idx], dt, t_run, precision), strict=True
+        ):
             out[i] = traj
     return out  # type: ignore[return-value]
 
@@ -305,7 +307,7 @@ def _run_group(scenes: list[Scene], dt: float, t_end: float, precision: str) -> 
     mx = mjx.put_model(model)
     y0s = [initial_state(sc.initial) for sc in scenes]
     datas, rows0 = [], []
-    for sc, y0 in zip(scenes, y0s):
+    for sc, y0 in zip(scenes, y0s, strict=True):
         data = mujoco.MjData(model)
         qpos, qvel = to_mujoco_state(staggered_start(sc, y0, dt))
         data.qpos[:], data.qvel[:] = qpos, qvel
@@ -328,7 +330,7 @@ def _run_group(scenes: list[Scene], dt: float, t_end: float, precision: str) -> 
     wall = time.perf_counter() - t_wall - compile_s
     Q, V, Fs = (np.concatenate(x, axis=1) for x in (qs, vs, fs))
     out = []
-    for b, (sc, y0) in enumerate(zip(scenes, y0s)):
+    for b, (sc, y0) in enumerate(zip(scenes, y0s, strict=True)):
         states = np.concatenate([rows0[b][None], from_mujoco_state(Q[b], V[b])])
         forces = _per_contact(Fs[b], slots, sc.n_contacts)
         status, message = Status.T_END, f"reached t_end = {t_end:g}"
