@@ -72,9 +72,9 @@ BOUNCING_VELOCITY_THRESHOLD = 0.1
 MAX_BOUNCING_VELOCITY = 100.0
 # Steps per chunk of the run loop: progress and the fall-through check after each.
 CHUNK_STEPS = 20_000
-# Tuned units: the bound of any contact's speed (`speed_bound`) maps to this fraction of
-# DART's clamp, so no rebound is clamped (a factor 3 to spare) and the cut-off sits at
-# 1/3000 of that bound.
+# Tuned units: the bound of any contact's speed (`speed_bound`) maps to 1/CLAMP_MARGIN of
+# DART's clamp, so no rebound is clamped (a factor 3 to spare); the cut-off, 1/1000 of the
+# clamp, then sits at 3e-3 of that bound (3e-3 √(g a) on pentagon-bounce).
 CLAMP_MARGIN = 3.0
 # Ground box: thickness and half-width in units of the body radius (only its top face
 # is touched; wide enough that the body never leaves it).
@@ -120,7 +120,7 @@ def contact_settings(scene: Scene, dt: float, profile: str) -> DartSettings:
     gamma = scene.restitution
     if profile == "tuned":
         # λ: the fastest possible rebound (≤ the speed bound) stays CLAMP_MARGIN below
-        # DART's clamp; the cut-off then sits at bound/(CLAMP_MARGIN·1000).
+        # DART's clamp; the cut-off then sits at CLAMP_MARGIN·bound/1000.
         bound = speed_bound(scene, dt)
         scale = MAX_BOUNCING_VELOCITY / (CLAMP_MARGIN * bound) if bound > 0 else 1.0
         return DartSettings(

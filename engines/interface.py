@@ -1,7 +1,7 @@
 """The engine interface, typed: what an entry point of the group `harness.engines` is
 (docs/engines.md "Plugging in an engine").
 
-An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with six optional
+An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with seven optional
 attributes; `engine_entry` sets them on a function, and `attribute` reads one with its
 default (harness.simulators reads them only through it).  A fixed-step adapter usually
 wraps its engine in an `engines.stepping.Stepper` and lets `engines.stepping.run_steps`
@@ -33,6 +33,11 @@ class Engine(Protocol):
                       (`pip install 'euler-disk-harness[EXTRA]'`), or None when `library`
                       is a core dependency (or comes from elsewhere); `harness engines`
                       shows it for an engine whose library is missing
+    simulate_batch    optional: `simulate_batch(scenes, *, dt, t_end) -> list[Trajectory]`,
+                      many scenes at one dt in one call (t_end None: each scene's own
+                      run.t_end), each result the Trajectory the serial call gives;
+                      None when the engine offers no batch (`run_batch` in
+                      harness.simulators then loops serially)
     """
 
     fixed_step: bool
@@ -55,6 +60,7 @@ DEFAULTS: dict[str, Any] = {
     "reports_progress": False,
     "ground_kinds": None,
     "extra": None,
+    "simulate_batch": None,
 }
 
 

@@ -198,6 +198,36 @@ def run_simulator(
     return guard_trajectory(scene, traj)
 
 
+def offers_batch(engine: str) -> bool:
+    """Whether the engine offers `simulate_batch` (engines.interface.Engine)."""
+    return attribute(load_engine(engine), "simulate_batch") is not None
+
+
+def run_batch(
+    engine: str, scenes: list[Scene], dt: float | None = None, t_end: float | None = None
+) -> list[Trajectory]:
+    """Run many scenes at one dt: through the engine's `simulate_batch` when it offers
+    one, serially through `run_simulator` otherwise.  Every scene is checked first
+    (`check_run`) and every result guarded, as `run_simulator` does; t_end None: each
+    scene's own run.t_end.  A batch that raises falls back to the serial runs."""
+    from reference.scenes import as_scene
+
+    from .guard import guard_trajectory
+
+    scenes = [as_scene(s) for s in scenes]
+    batch = attribute(load_engine(engine), "simulate_batch")
+    if batch is None or not scenes:
+        return [run_simulator(engine, s, dt, t_end) for s in scenes]
+    steps = {check_run(engine, s, dt, t_end) for s in scenes}
+    try:
+        trajs = batch(scenes, dt=steps.pop(), t_end=t_end)
+    except SceneError:
+        raise
+    except Exception:  # the batch broke: each scene on its own says why
+        return [run_simulator(engine, s, dt, t_end) for s in scenes]
+    return [guard_trajectory(s, tr) for s, tr in zip(scenes, trajs, strict=True)]
+
+
 def _error_text(exc: BaseException, limit: int = 2000) -> str:
     """The last frames of an engine's traceback, for the run's stats."""
     import traceback
