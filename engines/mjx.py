@@ -46,6 +46,7 @@ from reference.trajectory import Trajectory
 
 from .mujoco import from_mujoco_state, staggered_start, to_mujoco_state, whole_step_velocities
 from .mujoco_model import build_spec, contact_geom_pairs, contact_settings
+from .quiet import quiet_import
 from .stepping import (
     Recording,
     Rows,
@@ -65,8 +66,8 @@ def _jax(precision: str):
     import jax
 
     jax.config.update("jax_enable_x64", precision == "float64")
-    from mujoco import mjx
-
+    # it prints "Failed to import warp" (its optional Warp backend) to stdout on import
+    mjx = quiet_import("mujoco.mjx")
     return jax, mjx
 
 
@@ -91,9 +92,7 @@ def contact_slots(model, scene: Scene) -> np.ndarray:
     index = {}
     for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
         index[frozenset((g1, g2))] = k
-    import jax  # noqa: F401  (the slots below follow MJX's collision pair order)
-    from mujoco import mjx
-
+    mjx = quiet_import("mujoco.mjx")
     dx = mjx.forward(mjx.put_model(model), mjx.put_data(model, data))
     geoms = np.asarray(dx.contact.geom)
     return np.array([index.get(frozenset((name[a], name[b])), -1) for a, b in geoms])
