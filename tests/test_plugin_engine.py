@@ -116,3 +116,38 @@ def test_pip_installed_plugin_appears_and_runs_without_changing_this_package(tmp
     )
     assert compared.returncode == 0, compared.stderr.decode()
     assert json.loads(compared.stdout)["engines"][0]["impacts_matched"] >= 4
+
+
+@pytest.fixture
+def missing_extra(tmp_path, monkeypatch):
+    """An engine whose library (a distribution that is not installed) comes from an
+    extra named `ghost`."""
+    _dist_info(tmp_path, "ghost-engine", "1.0", "ghost = ghost_engine:simulate")
+    (tmp_path / "ghost_engine.py").write_text(
+        "from engines.interface import engine_entry\n"
+        "@engine_entry(library='no-such-distribution-x7', extra='ghost')\n"
+        "def simulate(scene, *, dt=None, t_end=None):\n"
+        "    raise AssertionError('never run')\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    simulators.refresh()
+    yield
+    simulators.refresh()
+
+
+def test_harness_engines_names_the_extra_of_an_engine_that_is_not_installed(missing_extra, capsys):
+    assert main(["engines", "--json"]) == 0  # a missing extra is a choice, not an error
+    rows = {r["name"]: r for r in json.loads(capsys.readouterr().out)["engines"]}
+    ghost = rows["ghost"]
+    assert ghost["installed"] is False and ghost["error"] is None and ghost["extra"] == "ghost"
+    assert ghost["install"] == "pip install 'euler-disk-harness[ghost]'"
+    assert rows["mujoco"]["installed"] is True and rows["mujoco"]["extra"] is None
+    assert main(["engines"]) == 0
+    assert "not installed: pip install 'euler-disk-harness[ghost]'" in capsys.readouterr().out
+
+
+def test_running_an_engine_whose_extra_is_missing_is_one_line_exit_2(missing_extra, capsys):
+    code = main(["simulate", "pentagon-bounce", "--engine", "ghost", "--t-end", "0.01"])
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert code == 2 and len(err) == 1
+    assert "pip install 'euler-disk-harness[ghost]'" in err[0]
