@@ -114,9 +114,8 @@ def test_a_vmapped_batch_gives_the_serial_trajectories(bounce):
         assert b.status == serial.status and len(b.t) == len(serial.t)
         assert np.allclose(b.position, serial.position, rtol=0, atol=1e-12)
         assert np.allclose(b.angular_velocity, serial.angular_velocity, rtol=0, atol=1e-10)
-        assert [(e.contact, e.t) for e in b.impacts] == pytest.approx(
-            [(e.contact, e.t) for e in serial.impacts], abs=1e-12
-        )
+        assert [e.contact for e in b.impacts] == [e.contact for e in serial.impacts]
+        assert [e.t for e in b.impacts] == pytest.approx([e.t for e in serial.impacts], abs=1e-12)
     assert not np.allclose(batch[0].angular_velocity, batch[1].angular_velocity)
 
 
