@@ -151,3 +151,54 @@ def test_running_an_engine_whose_extra_is_missing_is_one_line_exit_2(missing_ext
     err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
     assert code == 2 and len(err) == 1
     assert "pip install 'euler-disk-harness[ghost]'" in err[0]
+
+
+@pytest.fixture
+def batching(tmp_path, monkeypatch):
+    """An engine `batchy` (MuJoCo underneath) that offers simulate_batch and counts its
+    calls in `batchy_engine.CALLS`."""
+    _dist_info(tmp_path, "batchy-engine", "1.0", "batchy = batchy_engine:simulate")
+    (tmp_path / "batchy_engine.py").write_text(
+        "from engines.builtin import mujoco\n"
+        "from engines.interface import engine_entry\n"
+        "CALLS = []\n"
+        "@engine_entry(fixed_step=True)\n"
+        "def simulate(scene, *, dt, t_end=None):\n"
+        "    return mujoco(scene, dt=dt, t_end=t_end)\n"
+        "def simulate_batch(scenes, *, dt, t_end=None):\n"
+        "    CALLS.append(len(scenes))\n"
+        "    return [mujoco(s, dt=dt, t_end=t_end) for s in scenes]\n"
+        "simulate.simulate_batch = simulate_batch\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    simulators.refresh()
+    import batchy_engine
+
+    batchy_engine.CALLS.clear()
+    yield batchy_engine
+    simulators.refresh()
+
+
+def test_run_batch_uses_the_engines_batch_and_gives_the_serial_runs(batching):
+    from tests.conftest import make_scene
+
+    scenes = [make_scene(n=5, t_end=0.3), make_scene(n=5, q=(0.02, 0.0, 0.05), t_end=0.3)]
+    assert simulators.offers_batch("batchy") and not simulators.offers_batch("mujoco")
+    batch = simulators.run_batch("batchy", scenes, 1e-4)
+    assert batching.CALLS == [2]
+    for sc, b in zip(scenes, batch, strict=True):
+        serial = simulators.run_simulator("mujoco", sc, 1e-4)
+        assert (b.t == serial.t).all() and (b.position == serial.position).all()
+        assert [e.t for e in b.impacts] == [e.t for e in serial.impacts]
+    fallback = simulators.run_batch("mujoco", scenes, 1e-4)  # no batch: serial runs
+    assert [len(t.impacts) for t in fallback] == [len(t.impacts) for t in batch]
+
+
+def test_restitution_runs_each_dt_and_phase_as_one_batch(batching):
+    from harness.restitution.study import Grid, run_study
+
+    grid = Grid(gammas=(0.5, 0.8), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
+    rows = run_study(["batchy"], grid)["engines"][0]["rows"]
+    assert batching.CALLS == [2, 2, 2]  # three onset phases, two gammas each
+    plain = run_study(["mujoco"], grid)["engines"][0]["rows"]
+    assert [r["e_eff"] for r in rows] == [r["e_eff"] for r in plain]
