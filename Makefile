@@ -32,7 +32,7 @@ $(AOT): $(STAMP) $(CORE)
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)
 
-setup: $(STAMP) $(AOT)
+setup: $(STAMP_ALL) $(AOT)
 
 # Main job: the reference against both tuned engines on the built-in chatter scene,
 # with a rerun recording of all three side by side (--force: the demo's own recording is
