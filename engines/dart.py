@@ -159,11 +159,11 @@ class DartModel:
     scale: float
 
 
-def _shape(dart, parent, shape, name: str, at, restitution: float, collide=True):
+def _shape(dart, parent, shape, name: str, at, restitution: float):
+    """A colliding, frictionless shape node at `at` (parent frame) with restitution."""
     node = parent.createShapeNode(shape, name)
     node.setRelativeTranslation(np.asarray(at, dtype=float))
-    if collide:
-        node.createCollisionAspect()
+    node.createCollisionAspect()
     aspect = node.createDynamicsAspect()
     aspect.setRestitutionCoeff(restitution)
     aspect.setFrictionCoeff(0.0)
@@ -300,10 +300,8 @@ class _Stepper:
         impulses = np.zeros((n_rows, scene.n_contacts))
         known = np.array(self.impulses[:n_rows]) if self.impulses else impulses[:0]
         impulses[: len(known)] = known
-        # the state one step past the last row is known when an impulse row follows it
-        if s.half_step_velocities:
-            after = None
-            states = whole_step_velocities(scene, states, after, impulses > 0.0, dt)
+        if s.half_step_velocities:  # the last row's next half step: from free flight
+            states = whole_step_velocities(scene, states, None, impulses > 0.0, dt)
             states[0, L.VELOCITIES] = self.y0[L.VELOCITIES]
         stats = {
             "profile": s.profile,

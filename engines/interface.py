@@ -2,10 +2,12 @@
 (docs/engines.md "Plugging in an engine").
 
 An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with seven optional
-attributes; `engine_entry` sets them on a function, and `attribute` reads one with its
-default (harness.simulators reads them only through it).  A fixed-step adapter usually
-wraps its engine in an `engines.stepping.Stepper` and lets `engines.stepping.run_steps`
-drive it (progress, fall-through checks, Ctrl-C); `examples/toy-engine` does both.
+attributes; `engine_entry` sets the first six on a function (`simulate_batch` is set by
+hand), and `attribute` reads one with its default (harness.simulators reads them only
+through it).  A fixed-step adapter usually wraps its engine in an
+`engines.stepping.Adapter` and lets `engines.stepping.simulate_fixed_step` drive it (end
+time, step count, progress, fall-through checks, Ctrl-C, common stats);
+`examples/toy-engine` does both.
 """
 
 from __future__ import annotations

@@ -48,6 +48,7 @@ from .mujoco import from_mujoco_state, staggered_start, to_mujoco_state, whole_s
 from .mujoco_model import build_spec, contact_geom_pairs, contact_settings
 from .quiet import quiet_import
 from .stepping import (
+    NON_FINITE,
     Recording,
     Rows,
     check_dt,
@@ -336,7 +337,7 @@ def _run_group(scenes: list[Scene], dt: float, t_end: float, precision: str) -> 
         failure = first_failure(sc, states)
         if failure is not None:
             row, what = failure
-            keep = row if what.startswith("the body's state became non-finite") else row + 1
+            keep = row if what == NON_FINITE else row + 1
             message = f"{what} at t = {row * dt:.6g}"
             states, status = states[:keep], Status.FAILED
         rec = _recording(sc, dt, states, forces, y0)
