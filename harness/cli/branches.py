@@ -47,7 +47,7 @@ def run(args) -> int:
     scene = load_scene_arg(args)
     check_run("reference", scene, None, args.t_end)
     if args.plot:
-        check_writable(args.plot, force=args.force, inputs=scene_inputs(args))
+        check_writable(args.plot, args.force, scene_inputs(args), what="--plot", suffixes=(".png",))
     spread = branches(scene, args.t_end, progress=log)
     doc = attach(spread.to_dict(), args)
     if args.plot:

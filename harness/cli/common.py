@@ -243,7 +243,9 @@ def add_impact_law(p: argparse.ArgumentParser) -> None:
         type=float_in(0.0, 1e50, what="a time window [s]"),
         metavar="T",
         help="contacts reaching the ground within T of each other are one simultaneous "
-        "impact under every law (default: the scene's, else 0: strictly sequential)",
+        "impact under every law; at most the motion's time unit sqrt(a/g) (t_end without "
+        "gravity), the time of a contact's own bounce, beyond which later bounces merge "
+        "(default: the scene's, else 0: strictly sequential)",
     )
 
 
