@@ -222,9 +222,7 @@ def run_batch(
     steps = {check_run(engine, s, dt, t_end) for s in scenes}
     try:
         trajs = batch(scenes, dt=steps.pop(), t_end=t_end)
-    except SceneError:
-        raise
-    except Exception:  # the batch broke: each scene on its own says why
+    except Exception:  # the batch broke or refused: each scene on its own says why
         return [run_simulator(engine, s, dt, t_end) for s in scenes]
     return [guard_trajectory(s, tr) for s, tr in zip(scenes, trajs, strict=True)]
 
