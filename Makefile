@@ -23,7 +23,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/pip install --quiet -e .
 	touch $(STAMP)
 
-# every extra ([all]: drake, dart, mjx, newton, dask) and the dev tools
+# every extra ([all]: drake, dart, mjx, dask) and the dev tools
 $(STAMP_ALL): $(STAMP)
 	$(BIN)/pip install --quiet -e '.[all,dev]'
 	touch $(STAMP_ALL)
