@@ -170,6 +170,9 @@ def test_every_output_names_the_law(tmp_path, capsys):
     landings = {r["t"] for r in doc["impacts"]}
     assert min(landings) == 1.0 and len(doc["impacts"]) == 6 * len(landings)
     assert doc["stats"]["simultaneous_impacts"] == len(landings)
+    assert main(["simulate", str(path), "--impact-law", "moreau"]) == 0
+    text = capsys.readouterr().out
+    assert f"impacts     {6 * len(landings)} ({len(landings)} simultaneous impacts" in text
     assert main(["simulate", str(path)]) == 0
     assert "impact law  paper (simultaneity window 0)" in capsys.readouterr().out
     assert main(["simulate", str(path), "--simultaneity-window", "-1"]) == 2
