@@ -32,7 +32,7 @@ from .core.records import (
     RETURN_DONE,
     RETURN_GROW,
 )
-from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
+from .core.tolerances import STALL_WINDOW, TILT_FLOOR
 from .geometry import initial_state
 from .options import ReferenceOptions
 from .scene import (
@@ -42,6 +42,7 @@ from .scene import (
     check_window_bound,
     reference_window,
     scene_from_dict,
+    time_unit,
     window_speed_unit,
 )
 from .stats import RunStats
@@ -156,6 +157,7 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["floor_depth"] = scene.ground.floor_below(scene.body)
     rec["law"] = law_code(scene.impact_law)
     rec["law_separating"] = law_of(rec["law"][0]).separating
+    rec["time_unit"] = time_unit(scene)
     return rec
 
 
@@ -340,14 +342,20 @@ _STATUS = {
     R.STATUS_BELOW_FLOOR: Status.LEFT_MODEL,
     R.STATUS_LAW_UNDECIDED: Status.SIMULTANEOUS_IMPACT,
     R.STATUS_FLAT_REST: Status.SINGULARITY,
+    R.STATUS_STALLED: Status.STALLED,
 }
+
+
+def _law_name(md) -> str:
+    """The name of the model record's impact law."""
+    from .core.laws import LAWS
+
+    return next(x.name for x in LAWS if x.code == int(md["law"]))
 
 
 def _law_undecided(st, md, t, cs) -> str:
     """Why the run's impact law left a simultaneous impact undecided (law_event)."""
-    from .core.laws import LAWS
-
-    law = next(x.name for x in LAWS if x.code == int(md["law"]))
+    law = _law_name(md)
     outcome = int(st["law_outcome"])
     if outcome == NOT_SETTLED:
         return (f"the {law} law did not settle after {MAX_SEQUENTIAL_IMPACTS} single "
@@ -411,10 +419,23 @@ _MESSAGES = {
         f"contact integration failed: step size below roundoff (at t = {t:.17g})"
     ),
     R.STATUS_FAILED_NO_ADVANCE: lambda st, op, md, t, cs: (
-        f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, or "
-        f"{MAX_STALL_STEPS} steps without progress, with contacts {cs} held)"
+        f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, with contacts {cs} held)"
     ),
+    R.STATUS_STALLED: lambda st, op, md, t, cs: _stalled(st, op, md, t, cs),
 }
+
+
+def _stalled(st, op, md, t, cs) -> str:
+    """Why the loop ended a run that stopped advancing (loop._stalled)."""
+    law = _law_name(md)
+    held = f"contacts {cs} held" if cs else "no contact held"
+    return (
+        f"the run stopped advancing at t = {t:.17g} ({held}, {law} law): {STALL_WINDOW} loop steps "
+        f"without an impact advanced t by {float(st['stall_advance']):.3g} s, less than "
+        f"{float(st['stall_bound']):.3g} s (contact_rtol = {float(op['contact_rtol']):g} "
+        "of the motion's time scale a step, the integrator's own error): the run would "
+        "not end"
+    )
 
 
 def status_message(state: np.void, opts: np.void, model: np.void) -> tuple[Status, str]:

@@ -32,6 +32,7 @@ class Status(StrEnum):
     MAX_IMPACTS = "max_impacts"  # impact budget exhausted
     LEFT_MODEL = "left_model"  # the motion left the model (three_point: off the bumps)
     FAILED = "failed"  # the simulator broke (NaN, solver failure, ...)
+    STALLED = "stalled"  # the run stopped advancing (the reference's progress check)
 
 
 @dataclass(frozen=True)

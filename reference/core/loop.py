@@ -16,7 +16,9 @@ explicit status and never guesses:
 - a bump outside the face on the three-point ground ends it `left_model`, and so does
   its rim reaching the floor plane under the bumps, which that ground does not model
   (reference.core.floor: located in flight and in contact phases, or at the start);
-- a loop that stops advancing (MAX_STALL_STEPS steps at one time) ends it as failed.
+- a loop that stops advancing (a window of STALL_WINDOW steps without an impact that
+  advanced the clock by less than contact_rtol of the motion's time scale a step:
+  `_stalled`) ends it `stalled`, with the time, the contacts held and the law.
 
 Time is a double-double and every phase runs in its own local time, so intervals near
 the singularity keep their digits.  The loop returns to Python after `work_budget`
@@ -50,17 +52,17 @@ from .records import (
     RETURN_GROW,
     RETURN_YIELD,
     STATUS_ENERGY_EXHAUSTED,
-    STATUS_FAILED_NO_ADVANCE,
     STATUS_FAILED_NONFINITE,
     STATUS_MAX_IMPACTS,
     STATUS_OFF_FACE,
     STATUS_RUNNING,
     STATUS_SINGULARITY,
+    STATUS_STALLED,
     STATUS_T_END,
     STATUS_TILT_FLOOR,
     STEP_ROWS,
 )
-from .tolerances import MAX_PERIOD, MAX_STALL_STEPS, PERIOD_RATIO_TOL, TILT_FLOOR
+from .tolerances import MAX_PERIOD, PERIOD_RATIO_TOL, STALL_WINDOW, TILT_FLOOR, TINY
 from .workspace import contact_lists
 
 
@@ -166,17 +168,45 @@ def _finite(y):
 
 
 @hot
-def _stalled(state, out):
-    """Whether MAX_STALL_STEPS steps in a row have neither advanced time nor recorded an
-    event (impact, phase or accumulation): a loop that cannot advance, ended with
-    STATUS_FAILED_NO_ADVANCE rather than run forever."""
-    c = out.counts
-    events = c[N_IMPACTS] + c[N_PHASES] + c[N_ACCUMULATIONS]
-    if state.t_hi != state.stall_t or events != state.stall_events:
-        state.stall_t, state.stall_events, state.stall_steps = state.t_hi, events, 0
-        return False
+def motion_time_scale(y, model):
+    """T = min(τ, a/V): the motion's own time scale, the shorter of gravity's τ = √(a/g)
+    (scene.time_unit: t_end without gravity) and the time a/V in which the rim moves by
+    its own radius at the velocity scale V = |v| + a|ω| (the scales of the contact
+    phases' chunk horizon, reference.core.candidates)."""
+    a = model.radius
+    return min(model.time_unit, a / max(velocity_scale(y, a), TINY))
+
+
+@hot
+def _stalled(state, model, opts, out):
+    """Whether the run has stopped advancing: a window of STALL_WINDOW loop steps without
+    an impact advanced the clock by less than STALL_WINDOW × contact_rtol × T (T the
+    motion's time scale, `motion_time_scale`).
+
+    Why this bound: free flights are exact and end at an event, contact phases are
+    integrated to a relative tolerance rtol = contact_rtol of the state's scale, so a
+    step shorter than rtol·T moves the state by less than the integrator's own error in
+    it.  A run whose steps average below that has stopped advancing: it only adds
+    roundoff (the bumpy ground's contact phases can creep at 1e-19 s a step, 15 decades
+    below their own time scale, and would take 10¹⁷ steps to t_end).  Impacts are
+    progress whatever their intervals (a run approaching its singularity advances by
+    ever shorter ones, down to the tilt floor), each counted against max_impacts: an
+    impact starts a new window.  So between impacts a run advances by at least
+    STALL_WINDOW rtol T per window: its work is bounded by STALL_WINDOW (max_impacts +
+    1) steps plus t_end / (rtol T) chunks.  A stalled run ends STATUS_STALLED, the
+    window's advance and its bound in state.stall_advance and state.stall_bound."""
+    n = out.counts[N_IMPACTS]
+    if n != state.stall_impacts or state.stall_steps >= STALL_WINDOW:
+        if n == state.stall_impacts:  # a full window without an impact: its advance
+            advance = (state.t_hi - state.stall_t) + (state.t_lo - state.stall_t_lo)
+            bound = STALL_WINDOW * opts.contact_rtol * motion_time_scale(state.y, model)
+            if advance < bound:
+                state.stall_advance, state.stall_bound = advance, bound
+                return True
+        state.stall_t, state.stall_t_lo, state.stall_impacts = state.t_hi, state.t_lo, n
+        state.stall_steps = 0
     state.stall_steps += 1
-    return state.stall_steps > MAX_STALL_STEPS
+    return False
 
 
 @hot
@@ -241,8 +271,10 @@ def run_events(
         stats.loop_steps += 1
         if state.status == STATUS_RUNNING and not _finite(state.y):
             end_run(state, STATUS_FAILED_NONFINITE, cs.together, 0)
-        elif state.status == STATUS_RUNNING and _stalled(state, out):
-            end_run(state, STATUS_FAILED_NO_ADVANCE, state.active, state.n_active)
+        elif state.status == STATUS_RUNNING and _stalled(state, model, opts, out):
+            if state.in_contact:
+                close_contact_phase(state, model, stats, out)
+            end_run(state, STATUS_STALLED, state.active, state.n_active)
         elif state.status == STATUS_RUNNING and _held_off_face(state, model, pts, cs.together):
             if state.in_contact:
                 close_contact_phase(state, model, stats, out)

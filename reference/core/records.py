@@ -83,6 +83,7 @@ MODEL = np.dtype(
         # without rim vertices (reference.core.floor); inf: none
         ("law", np.int64),  # the impact law's code (reference.core.laws)
         ("law_separating", np.bool_),  # its impact takes separating contacts too
+        ("time_unit", np.float64),  # τ = √(a/g) (t_end without gravity): scene.time_unit
     ]
 )
 
@@ -128,9 +129,12 @@ STATE = np.dtype(
         ("n_info", np.int64),  # contacts involved (simultaneous impact)
         ("info", np.int64, (16,)),
         ("t_singularity", np.float64),  # NaN unless the run reached the singularity
-        ("stall_t", np.float64),  # the time and event count of the last step that
-        ("stall_events", np.int64),  # advanced, and how many steps since have not
+        ("stall_t", np.float64),  # the start of the stall window (loop._stalled): its
+        ("stall_t_lo", np.float64),  # time, the impacts recorded by then and the steps
+        ("stall_impacts", np.int64),  # taken since
         ("stall_steps", np.int64),
+        ("stall_advance", np.float64),  # a stalled run's last window: the time it
+        ("stall_bound", np.float64),  # advanced and the least it had to
         ("recheck", np.bool_),  # after a law impact: resolve the touching contacts
         ("law_t_hi", np.float64),  # the time of the last law impact and how many
         ("law_t_lo", np.float64),  # happened at it (reference.core.law_event)
@@ -158,6 +162,7 @@ STATUS_OFF_FACE = 13  # a floor point outside the face's rim (contacts.off_face)
 STATUS_BELOW_FLOOR = 14  # the rim reached the floor plane of a ground without rim contacts
 STATUS_LAW_UNDECIDED = 15  # the impact law left a simultaneous impact undecided
 STATUS_FLAT_REST = 16  # singularity: flat bounces completed, at rest (law_event)
+STATUS_STALLED = 17  # a stall window advanced below the motion's resolution (loop._stalled)
 
 # Counters of a run (reference.stats.RunStats reads them by name).
 STATS = np.dtype(

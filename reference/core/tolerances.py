@@ -41,9 +41,13 @@ POLISH_REL_TOL = 1e-16
 BRACKET_ITERATIONS = 60
 # Free-flight search iterations before the run is declared stuck.
 MAX_SEARCH_ITERATIONS = 100_000
-# Loop steps in a row that neither advance time nor record an event before the run is
-# ended as unable to advance (a guard: no known case reaches it).
-MAX_STALL_STEPS = 1000
+# Progress (reference.core.loop._stalled): a window of STALL_WINDOW loop steps without
+# an impact must advance the clock by STALL_WINDOW × contact_rtol × T on average (T the
+# motion's time scale), else the run ends `stalled`.  A window long enough that no
+# legitimate stretch without impacts falls below it: the check scenes' and sweeps'
+# longest such stretches are far shorter or far faster (docs/architecture.md), and
+# short enough to end a creeping run within a few seconds (≤ 2 windows, ~10 µs a step).
+STALL_WINDOW = 100_000
 
 # Large polygons: for n > SMALL_N a search step near the ground examines only the
 # vertices near the lowest direction (far from it the circle through the vertices bounds
