@@ -46,7 +46,7 @@ def guard_trajectory(scene: Scene, traj: Trajectory) -> Trajectory:
         cut = int(np.searchsorted(traj.t, t_bad, side="left"))
         found = (cut, why)
     if found is None:
-        if traj.n_samples == 0 and traj.status is not Status.FAILED:
+        if traj.n_samples == 0 and traj.status not in (Status.FAILED, Status.STALLED):
             return dataclasses.replace(
                 traj, status=Status.FAILED, message="the simulator returned no samples"
             )

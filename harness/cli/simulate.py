@@ -25,6 +25,22 @@ from .common import (
 INTERRUPTED = 130
 
 
+def work_bound_text() -> str:
+    """The reference's bound on its work (reference.core.loop._stalled), for --help."""
+    from reference.core.tolerances import STALL_WINDOW
+    from reference.options import ReferenceOptions
+
+    rtol = ReferenceOptions().contact_rtol
+    return (
+        f"The reference's work is bounded: every {STALL_WINDOW:,} loop steps without an "
+        f"impact must advance t by at least contact_rtol ({rtol:g}) of the motion's time "
+        "scale T = min(sqrt(a/g), a/V) a step (V = |v| + a|w|), else the run ends "
+        "'stalled' (its message names t, the contacts held and the impact law); so a run "
+        f"takes at most {STALL_WINDOW:,} x (max_impacts + 1) steps plus t_end / "
+        "(contact_rtol T) contact chunks."
+    )
+
+
 def register(sub) -> None:
     s = sub.add_parser(
         "simulate",
@@ -32,7 +48,7 @@ def register(sub) -> None:
         description="One run of one simulator on one scene.  Prints the run's summary "
         "(status, impacts, energy, final state).  Exit status 0 done (whatever the "
         "physics), 2 bad input, 130 stopped by Ctrl-C, 143 by SIGTERM (the summary of the "
-        "part computed is printed, no file is written).",
+        "part computed is printed, no file is written).  " + work_bound_text(),
     )
     add_scene(s)
     add_engine(s)

@@ -261,7 +261,7 @@ def _progress_line(engine: str, dt: float | None, traj: Trajectory, wall: float)
     label = engine if dt is None else f"{engine} dt={dt:g}"
     text = f"compare: {label}: {traj.status.value}, {len(traj.impacts)} impacts, "
     text += f"t_final={traj.t_final:.6g} ({wall:.2f} s)"
-    if traj.status.value == "failed" and traj.message:
+    if traj.status.value in ("failed", "stalled") and traj.message:
         text += f": {traj.message}"
     return text
 

@@ -127,8 +127,8 @@ def horizon_sentence(run: EngineRun) -> str | None:
 def divergence_short(run: EngineRun, scene: Scene) -> str:
     """Why a run left the reference, in at most ~30 characters."""
     m = run.metrics
-    if run.trajectory.status is Status.FAILED:
-        return "failed (message below)"
+    if run.trajectory.status in (Status.FAILED, Status.STALLED):
+        return f"{run.trajectory.status.value} (message below)"
     if m.first_divergence_time is None:
         return "no common time window" if m.common_window is None else "none"
     if m.divergence_kind == "attitude":
@@ -298,9 +298,12 @@ LEGEND = (
 def _failures(result: CompareResult) -> list[str]:
     lines = []
     for run in result.runs:
-        if run.trajectory.status is Status.FAILED and run.trajectory.message:
+        status = run.trajectory.status
+        if status in (Status.FAILED, Status.STALLED) and run.trajectory.message:
             lines += textwrap.wrap(
-                f"{run.label} failed: {run.trajectory.message}", WIDTH, subsequent_indent="  "
+                f"{run.label} {status.value}: {run.trajectory.message}",
+                WIDTH,
+                subsequent_indent="  ",
             )
     return lines
 

@@ -25,6 +25,9 @@ FAILED_PENETRATION = 0.5
 TOLERANCES = {"reference": (1e-9, 1e-9), "approximate": (1e-3, 1e-2)}
 # Physics statuses that end a run legitimately before t_end.
 STOPS = {Status.SINGULARITY, Status.SIMULTANEOUS_IMPACT, Status.MAX_IMPACTS, Status.LEFT_MODEL}
+# Statuses of a run that ended without finishing: the simulator broke, or stopped
+# advancing (the reference's progress check).
+BROKEN = {Status.FAILED, Status.STALLED}
 
 
 # ----------------------------------------------------------------------------- judging
@@ -160,16 +163,16 @@ def _impact_comparison(run: Trajectory, reference: Trajectory, scene: Scene) -> 
 def _run_failures(
     run: Trajectory, row: dict[str, Any], reached: bool, error: str | None
 ) -> list[str]:
-    """Why a run failed by itself: the exception it raised, NaN, status failed, or
-    stopping before t_end without a physics reason."""
+    """Why a run failed by itself: the exception it raised, NaN, status failed or
+    stalled, or stopping before t_end without a physics reason."""
     failed = []
     if error is not None:
         failed.append(f"raised {error}")
     if row["nan"]:
         failed.append("NaN in the state")
     if not row["finished"] and error is None:
-        if run.status is Status.FAILED:
-            failed.append(f"status failed: {run.message}")
+        if run.status in BROKEN:
+            failed.append(f"status {run.status.value}: {run.message}")
         elif not reached:
             failed.append(f"stopped at t={run.t_final:.6g} before t_end={row['t_target']:.6g}")
     return failed
@@ -216,10 +219,7 @@ def assess(
     slack = max(float(run.dt or 0.0), 1e-9 * t_target)
     reached = run.t_final >= t_target - slack
     finished = (
-        error is None
-        and run.status is not Status.FAILED
-        and not nan
-        and (reached or run.status in STOPS)
+        error is None and run.status not in BROKEN and not nan and (reached or run.status in STOPS)
     )
     gain = energy_gain(run)
     depth = max_penetration(run, scene)
