@@ -9,7 +9,7 @@ from reference.options import ReferenceOptions
 from reference.scene import Body, Ground, RunSettings, Scene, initial_from_linear
 from reference.simulate import simulate
 from reference.trajectory import Status
-from tests.conftest import angular_momentum, empty_output, states_of
+from tests.conftest import angular_momentum, states_of
 from tests.oracle.simulate import simulate as oracle_simulate
 
 CASES = {  # (ρ, γ, q0, p0) of the sweep (n = 3, a = m = g = 1)
@@ -120,22 +120,3 @@ def test_released_contacts_whose_gaps_still_fall_land_and_the_run_ends():
     assert traj.stats.loop_steps < 5 * len(traj.impacts)
     assert np.all(np.diff(traj.energy) <= 1e-12 * abs(traj.energy[0]))
     assert traj.stats.max_penetration <= 1e-15  # roundoff of a = 1
-
-
-def test_a_loop_that_stops_advancing_is_ended_by_the_stall_guard():
-    """loop._stalled: MAX_STALL_STEPS steps in a row with the same time and event count
-    end the run; a step that advances time, or records an event, starts the count again."""
-    from reference.core import records as R
-    from reference.core.loop import _stalled
-    from reference.core.tolerances import MAX_STALL_STEPS
-    from reference.simulate import initial_record
-
-    state = initial_record(np.zeros(13))
-    out = empty_output()
-    counts = out.counts
-    state["t_hi"] = 1.0
-    assert not _stalled(state[0], out)  # a new time: the count starts
-    assert not any(_stalled(state[0], out) for _ in range(MAX_STALL_STEPS))
-    counts[R.N_IMPACTS] += 1  # an event: the count starts again
-    assert not any(_stalled(state[0], out) for _ in range(MAX_STALL_STEPS + 1))
-    assert _stalled(state[0], out)

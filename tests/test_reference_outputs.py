@@ -95,6 +95,7 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
         "FAILED_STUCK": Status.FAILED,
         "FAILED_INTEGRATION": Status.FAILED,
         "FAILED_NO_ADVANCE": Status.FAILED,
+        "STALLED": Status.STALLED,
     }
 
     scene = resolve_scene("rod")
