@@ -120,6 +120,15 @@ def test_run_stopping_early_is_not_finished():
     assert S.assess(stopped, None, flat_scene(), 2.0)["finished"] is True
 
 
+def test_a_stalled_run_fails_with_its_message_even_when_it_reached_t_end():
+    run = level_run([H, H, H], [1.0, 1.0, 1.0], status=Status.STALLED)
+    run.message = "the run stopped advancing at t = 1"
+    row = S.assess(run, None, flat_scene(), 2.0)
+    assert row["finished"] is False and row["verdict"] == "failed"
+    assert "status stalled: the run stopped advancing" in row["reason"]
+    assert S.assess(run, None, flat_scene(), 1.0)["verdict"] == "failed"
+
+
 def test_exception_fails():
     row = S.assess(level_run([H], [1.0]), None, flat_scene(), 0.0, error="RuntimeError: boom")
     assert row["verdict"] == "failed" and "boom" in row["reason"]
