@@ -43,10 +43,10 @@ BRACKET_ITERATIONS = 60
 MAX_SEARCH_ITERATIONS = 100_000
 # Progress (reference.core.loop._stalled): a window of STALL_WINDOW loop steps without
 # an impact must advance the clock by STALL_WINDOW × contact_rtol × T on average (T the
-# motion's time scale), else the run ends `stalled`.  A window long enough that no
-# legitimate stretch without impacts falls below it: the check scenes' and sweeps'
-# longest such stretches are far shorter or far faster (docs/architecture.md), and
-# short enough to end a creeping run within a few seconds (≤ 2 windows, ~10 µs a step).
+# motion's time scale), else the run ends `stalled`.  Long enough that no legitimate
+# stretch without impacts is judged: none of the check scenes has one of 1,000 steps
+# under any law but a creeping run (docs/architecture.md, statuses), and short enough
+# to end a creeping run within a few seconds (≤ 2 windows, ~10 µs a step).
 STALL_WINDOW = 100_000
 
 # Large polygons: for n > SMALL_N a search step near the ground examines only the
