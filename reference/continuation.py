@@ -29,7 +29,7 @@ import numpy as np
 
 from .core import layout as L
 from .core import records as R
-from .core.impact_laws import (
+from .core.law_codes import (
     LAW_NAMES,
     MAX_LAW_CONTACTS,
     MAX_SEQUENTIAL_IMPACTS,

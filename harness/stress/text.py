@@ -8,10 +8,12 @@ many runs are degraded.
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
 from ..text import num as cell_text
 from ..text import table
+from .budget import HARD_CAP_FACTOR
 from .judge import FAILED_ENERGY_GAIN, FAILED_PENETRATION
 
 WIDTH = 100
@@ -41,9 +43,12 @@ def num(x: Any, spec: str = ".2e") -> str:
 
 def format_stress(doc: dict[str, Any], wide: bool = False) -> str:
     """The report (module docstring)."""
-    lines = [
-        f"stress: fixed-step engines at dt = {doc['dt']:g} s, budget {doc['budget_s']:g} s per run"
-    ]
+    budget = doc["budget_s"]
+    lines = textwrap.wrap(
+        f"stress: fixed-step engines at dt = {doc['dt']:g} s; a run predicted over {budget:g} s "
+        f"is skipped, stopped at {HARD_CAP_FACTOR * budget:g} s",
+        WIDTH,
+    )
     if wide:
         lines += [wide_table(doc), "", *reason_lines(doc, wide=True)]
     else:

@@ -46,17 +46,18 @@ import math
 
 from .impact import post_impact_velocity
 from .jit import hot
-
-LAW_PAPER = 0
-LAW_MOREAU = 1
-LAW_SEQUENTIAL = 2
-LAW_NAMES = ("paper", "moreau", "sequential")
-
-# Outcomes of a law's solve
-SETTLED = 0
-NOT_SETTLED = 1  # sequential: MAX_SEQUENTIAL_IMPACTS reached; moreau: pivot cap
-SINGULAR = 2  # a contact whose W_ii is not positive (no impulse can move it)
-TOO_MANY = 3  # more than MAX_LAW_CONTACTS contacts
+from .law_codes import (  # noqa: F401  (the codes and limits, re-exported)
+    LAW_MOREAU,
+    LAW_NAMES,
+    LAW_PAPER,
+    LAW_SEQUENTIAL,
+    MAX_LAW_CONTACTS,
+    MAX_SEQUENTIAL_IMPACTS,
+    NOT_SETTLED,
+    SETTLED,
+    SINGULAR,
+    TOO_MANY,
+)
 
 # Tikhonov weight ε = REGULARISATION × max Wᵢᵢ: the regularised matrix has condition
 # ≤ 1e8, so its solve is good to ~1e-8 relative along W's near-null directions (the
@@ -66,16 +67,12 @@ REGULARISATION = 1e-8
 # two adjacent vertices of a 1000-gon, λ ≈ 4e-5 max Wᵢᵢ, converge by ~0.7 per pass)
 REFINE_REGULARISATION = 1e-4
 MAX_REFINE_PASSES = 400
-# the laws take at most this many contacts (Moreau's pivoting costs O(k⁴) at worst): a
-# larger polygon landing flat ends the run undecidable, saying so
-MAX_LAW_CONTACTS = 64
 # complementarity tolerance of the pivoting, relative to the largest |qᵢ| (roundoff)
 PIVOT_TOL = 64.0 * 2.220446049250313e-16
 # the sequential law has settled when no contact approaches faster than this × max|u⁻|:
 # below the loop's velocity roundoff (RATE_NOISE_ULPS ε V, V ≥ |u|), so that the loop
 # takes what is left for rest, not for a new impact an instant later
 SETTLE_REL = 16.0 * 2.220446049250313e-16
-MAX_SEQUENTIAL_IMPACTS = 100_000
 
 
 @hot
