@@ -249,12 +249,23 @@ def _verdict_table(result: CompareResult) -> str:
     drop = {2} if all(r[2] == "0" for r in rows) else set()
     drop |= {7} if all(r[7] == "-" for r in rows) else set()
     drop |= {3} if len(_reference_counts(result)) == 1 else set()
-    keep = [i for i in range(len(header)) if i not in drop]
-    return table(
-        [[r[i] for i in keep] for r in rows],
-        [header[i] for i in keep],
-        align="".join(align[i] for i in keep),
+    # when the table is wider than WIDTH (long engine names beside an exponent): the wall
+    # time left out, then the exponent, each with a note (--wide has every column)
+    attempts = (
+        (set(), ""),
+        ({8}, "\n(wall time left out to stay within 100 columns: --wide has it)"),
+        ({8, 7}, "\n(wall time and c left out to stay within 100 columns: --wide has them)"),
     )
+    for extra, note in attempts:
+        keep = [i for i in range(len(header)) if i not in drop | extra]
+        text = table(
+            [[r[i] for i in keep] for r in rows],
+            [header[i] for i in keep],
+            align="".join(align[i] for i in keep),
+        )
+        if max(len(line) for line in text.splitlines()) <= WIDTH:
+            return text + note
+    return text + note
 
 
 def _table_intro(result: CompareResult) -> str:
@@ -279,7 +290,7 @@ def _horizon_table(result: CompareResult) -> list[str]:
         rows.append(
             [
                 run.label,
-                str(run.metrics.impacts_matched),
+                str(h.matched),
                 "-" if grid is None else _count_range(grid),
                 "-" if h.within is None else ("yes" if h.within else "no"),
                 _num(h.own_error),
@@ -355,14 +366,22 @@ def horizon_verdict(run: EngineRun) -> str | None:
     )
 
 
-LEGEND = (
-    "matched: leading reference impacts the run reproduces (same contact, time within "
-    f"{STEPS_TIME_TOLERANCE:g}·dt + {RELATIVE_TIME_TOLERANCE:g}·t); skipped: slow "
-    "chatter-tail bounces of the reference passed over on the way. E error: "
-    "max|E − E_ref|/E_ref(0) while the run follows the reference. c: energy exponent ± its "
-    "standard error (runs that reach the singularity). v2 = vertex 2, b2 = bump 2. "
-    "Every column: --wide; definitions: docs/output.md."
-)
+def legend(result: CompareResult) -> str:
+    """What the verdict table's columns mean, for the columns it shows."""
+    parts = [
+        "simulator: the engine and its timestep dt in s. matched: leading reference impacts "
+        "the run reproduces (same contact, time within "
+        f"{STEPS_TIME_TOLERANCE:g}·dt + {RELATIVE_TIME_TOLERANCE:g}·t)."
+    ]
+    if any(run.metrics.skipped_reference for run in result.runs):
+        parts.append("skipped: slow chatter-tail bounces of the reference passed over on the way.")
+    parts.append("E error: max|E − E_ref|/E_ref(0) while the run follows the reference.")
+    if any(run.exponent is not None and run.exponent.c is not None for run in result.runs):
+        parts.append("c: energy exponent ± its standard error (runs that reach the singularity).")
+    parts.append(
+        "v2 = rim vertex 2, b2 = bump 2. Every column: --wide; definitions: docs/output.md."
+    )
+    return " ".join(parts)
 
 
 def _failures(result: CompareResult) -> list[str]:
@@ -386,7 +405,7 @@ def format_compare(result: CompareResult, wide: bool = False) -> str:
     branches = branch_lines(result)
     if branches:
         lines += ["", *branches]
-    lines += ["", *textwrap.wrap(LEGEND, WIDTH)]
+    lines += ["", *textwrap.wrap(legend(result), WIDTH)]
     return "\n".join(lines)
 
 
