@@ -29,6 +29,8 @@ SMALL: dict[str, dict[str, list[str]]] = {
     "stress": {"--engine": ["mujoco"], "--case": ["grazing"]},
     "fidelity": {"--engine": ["mujoco"], "--dt": ["1e-3"], "--eps-grid": ["1:0.01:3"]},
     "sweep": {"--gyration": ["0.3:0.6:2"], "--restitution": ["0.2:0.4:2"], "--samples": ["5"]},
+    # one figure (tests/test_paper_figures.py draws each of them)
+    "figures": {"--only": ["rod_clin"]},
     "restitution": {
         "--engine": ["mujoco"],
         "--gamma": ["0.8"],
