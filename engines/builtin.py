@@ -103,3 +103,18 @@ drake_continuous = _profile(
     "drake",
     "Drake, continuous plant, error-controlled RK3 (dt = its maximum step)",
 )
+
+# The entry points this package registers (pyproject.toml, group harness.engines), name →
+# attribute of this module: `harness.simulators` loads these names from here without
+# reading every installed distribution's metadata (start-up); tests/test_plugin_engine.py
+# checks that the two lists agree.
+BUILTIN_ENGINES = {
+    "reference": "reference",
+    "linear": "linear",
+    "mujoco": "mujoco",
+    "mujoco-default": "mujoco_default",
+    "pybullet": "pybullet",
+    "pybullet-default": "pybullet_default",
+    "drake": "drake",
+    "drake-continuous": "drake_continuous",
+}
