@@ -4,6 +4,7 @@ markers, `<!-- fig:NAME -->…<!-- /fig:NAME -->` (`make docs-figures`).
     demo          README: the output of `make demo`'s compare (the legend included)
     stress        README: the reference's verdicts on the hard cases, its worst energy gain
                   and the time its runs took together
+    sweep         README: how the runs of its `sweep exponent` example end, the mapped c
     startup       README and docs/performance.md: `harness simulate pentagon-bounce
                   --json` against `python -c "import numpy"`, median of the ratios of
                   alternating pairs of whole processes
@@ -36,6 +37,9 @@ DEMO = ["compare", "triangle-chatter", "--engine", "mujoco", "--engine", "pybull
 DEMO += ["--engine", "linear"]
 STRESS = ["stress", "--engine", "reference", "--json"]
 STARTUP = ["simulate", "pentagon-bounce", "--json"]
+# README's sweep (its `## Commands` block), to a temporary folder
+SWEEP = ["sweep", "exponent", "--gyration", "0.05:1:4", "--restitution", "0:1:5"]
+SWEEP += ["--samples", "10", "--seed", "1", "--impact-law", "moreau", "--json"]
 MARKER = re.compile(r"<!-- fig:(?P<name>[\w-]+) -->(?P<body>.*?)<!-- /fig:(?P=name) -->", re.S)
 
 
@@ -91,6 +95,27 @@ def stress_summary(doc: dict) -> str:
     return f"reference `ok` on {ok} of {len(rows)}, energy gain ≤ {gain:.1e}, {wall:.1g} s together"
 
 
+def sweep_summary(doc: dict) -> str:
+    """What README's sweep shows: how its runs end and the range of the mapped c."""
+    counts = {k: v for k, v in doc["counts"].items() if v}
+    total = sum(counts.values())
+    ends = ", ".join(f"{v} `{k}`" for k, v in counts.items())
+    cs = [p["mean_c"] for p in doc["points"] if p["mean_c"] is not None]
+    rng = f"{min(cs):.2f} … {max(cs):.2f}" if cs else "-"
+    return (
+        f"its {total} runs end {ends} (none `simultaneous_impact`: under Moreau's law "
+        f"every simultaneous impact is resolved); {len(cs)} of {len(doc['points'])} cells "
+        f"have a fitted mean c, from {rng}"
+    )
+
+
+def run_sweep() -> dict:
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as out:
+        return json.loads(harness([*SWEEP, "--out", out]))
+
+
 def startup_ratio(pairs: int) -> tuple[float, float, float]:
     """(median ratio, median harness s, median numpy s) over `pairs` alternating runs
     (after one warm-up of each)."""
@@ -141,11 +166,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--only", action="append", help="this figure only (repeatable)")
     p.add_argument("--pairs", type=int, default=11, help="start-up: alternating pairs")
     args = p.parse_args(argv)
-    want = set(args.only or ("demo", "stress", "startup", "api"))
+    want = set(args.only or ("demo", "stress", "sweep", "startup", "api"))
     if "demo" in want:
         replace_figure(README, "demo", demo_block())
     if "stress" in want:
         replace_figure(README, "stress", stress_summary(json.loads(harness(STRESS))))
+    if "sweep" in want:
+        replace_figure(README, "sweep", sweep_summary(run_sweep()))
     if "startup" in want:
         ratio, a, b = startup_ratio(args.pairs)
         replace_figure(README, "startup", f'{ratio:.2f}× `python -c "import numpy"`')

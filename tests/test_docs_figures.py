@@ -50,6 +50,7 @@ def masked(text: str) -> list[list[str]]:
     [
         ("README.md", "demo"),
         ("README.md", "stress"),
+        ("README.md", "sweep"),
         ("README.md", "startup"),
         ("docs/performance.md", "startup"),
         ("docs/api.md", "api-output"),
@@ -98,3 +99,15 @@ def test_readme_demo_is_what_the_demo_prints(capsys):
     ours = masked(capsys.readouterr().out)
     readme = masked(block(quoted(ROOT / "README.md", "demo")))
     assert sum(readme, []) == sum(ours, [])  # word for word (wrapping follows the times)
+
+
+@pytest.mark.slow
+def test_readme_sweep_sentence_is_what_its_sweep_prints():
+    assert quoted(ROOT / "README.md", "sweep") == figures.sweep_summary(figures.run_sweep())
+
+
+def test_readme_sweep_sentence_is_about_the_readme_sweep_command():
+    from tests.test_readme_commands import readme_commands
+
+    sweep = next(line for line in readme_commands() if " sweep exponent " in line)
+    assert sweep.split(" ", 1)[1].split(" --out ")[0].split() == figures.SWEEP[:-1]
