@@ -19,18 +19,18 @@ from .judge import FAILED_ENERGY_GAIN, FAILED_PENETRATION
 WIDTH = 100
 SHORT_VERDICT = {
     "ok": "ok",
-    "degraded": "degr",
-    "failed": "FAIL",
-    "skipped (budget)": "skip",
+    "degraded": "degraded",
+    "failed": "FAILED",
+    "skipped (budget)": "skipped",
     "skipped (not runnable)": "n/a",
 }
 LEGEND = (
-    "ok: as the reference within the simulator's tolerances; degr (degraded): energy gain\n"
-    "or penetration above its tolerance, or a missed or spurious impact; FAIL (failed): NaN,\n"
-    f"not finished, energy gain > {FAILED_ENERGY_GAIN:.0%}, penetration > {FAILED_PENETRATION:g} L "
-    "(L: the case's length scale),\n"
-    "or none of the reference's impacts matched; skip: predicted over the budget; n/a:\n"
-    "cannot run at this dt.  --wide: every measurement and every reason; --json: every number"
+    "ok: as the reference within the simulator's tolerances; degraded: energy gain or\n"
+    "penetration above its tolerance, or a missed or spurious impact; FAILED: NaN, not\n"
+    f"finished, energy gain > {FAILED_ENERGY_GAIN:.0%}, penetration > {FAILED_PENETRATION:g} L "
+    "(L: the case's length scale), or none of the\n"
+    "reference's impacts matched; skipped: predicted over the budget; n/a: cannot run at\n"
+    "this dt.  --wide: every measurement and every reason; --json: every number"
 )
 # Verdicts whose reasons the default report lists (degraded ones: --wide).
 LISTED = ("failed", "skipped (budget)", "skipped (not runnable)")
