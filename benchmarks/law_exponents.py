@@ -1,4 +1,4 @@
-"""The energy exponent c under each impact law on the three-point ground (issue 31):
+"""The energy exponent c under each impact law on the three-point ground:
 the sweep's random numbers χ (harness.sweep.grid.chi) in the three-point-disk scene's
 scale, q = (0.01 χ3, 0.01 χ4, 0.02), p = (0.05 χ1, 0.05 χ2, −0.05) (the sweep's own
 states, dropped from h = 1, bounce off the bumps: `left_model`), a disk on three bumps

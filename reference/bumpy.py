@@ -1,4 +1,4 @@
-"""The `bumpy` ground (issue 32): the floor plane z = 0 with fixed bumps above it.
+"""The `bumpy` ground: the floor plane z = 0 with fixed bumps above it.
 
 The paper models the two imperfections apart (Baranyai & Várkonyi, sections 3 and 4): a
 polygonal rim on a flat floor, and a flat disk on three bumps.  On this ground both act

@@ -1,4 +1,5 @@
-"""Runs continued past undecidable states under an explicit impact law (issue 31).
+"""Runs continued past undecidable states under an explicit impact law
+(docs/laws.md).
 
 The compiled loop applies the paper's rule: where several contacts touch at an impact
 (two reached within its time resolution, or an impact that would push a held contact)

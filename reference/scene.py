@@ -76,7 +76,7 @@ DEFAULT_IMPACT_LAW = "paper"
 # together; 0 = strictly sequential (the core orders contacts down to its time
 # resolution).  1e-11: far above the event times' certified error (~1e-16 t), far below
 # the steps engines resolve (1e-4), and the largest decade that leaves the check scenes'
-# cascades alone (docs/architecture.md, "Impact laws", measured).  The linear model's
+# cascades alone (docs/laws.md, "The simultaneity window", measured).  The linear model's
 # default is 0 (reference.linear.simulate.LINEAR_DEFAULT_WINDOW)
 DEFAULT_SIMULTANEITY_WINDOW = 1e-11
 SCALE_RANGE = (1e-50, 1e50)
@@ -104,7 +104,7 @@ class Body:
 class Ground:
     """The scene file's [ground]: `flat`, the plane z = 0 that the body's rim vertices
     touch; `three_point`, floor points (bumps) at (b cos 2πk/3, b sin 2πk/3, 0) that
-    touch the body's face; `bumpy` (issue 32), both: the plane under the rim and bumps
+    touch the body's face; `bumpy`, both: the plane under the rim and bumps
     above it under the face, `bumps` (x, y, height) or three at (b cos 2πk/3,
     b sin 2πk/3, bump_height).  Lengths in the scene's units, like the body's radius.
     On `three_point` ground the floor plane lies `floor_depth` below the bumps' tops
@@ -534,7 +534,7 @@ def reference_window(scene: Scene, law: str | None = None) -> float:
 def default_window(law: str) -> float:
     """The reference's default window under `law`: 0 under `paper` (the paper's rule
     and its results as they are: a window there ends more runs `simultaneous_impact`,
-    measured in docs/architecture.md), DEFAULT_SIMULTANEITY_WINDOW under the laws that
+    measured in docs/laws.md), DEFAULT_SIMULTANEITY_WINDOW under the laws that
     resolve a simultaneous impact."""
     return 0.0 if law == "paper" else DEFAULT_SIMULTANEITY_WINDOW
 

@@ -1,6 +1,6 @@
 """The Python API validates like the command line (reference.checks, one shared check):
 `simulate`, `simulate_linear` and `run_simulator` raise SceneError for a NaN, zero,
-negative or out-of-range t_end and for unusable options, before any work (issue 34)."""
+negative or out-of-range t_end and for unusable options, before any work."""
 
 from __future__ import annotations
 

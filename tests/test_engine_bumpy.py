@@ -1,4 +1,4 @@
-"""Engines on the bumpy ground (issue 32): the model MuJoCo builds (vertex spheres over the
+"""Engines on the bumpy ground: the model MuJoCo builds (vertex spheres over the
 plane, bump spheres under the face, and no other pair colliding) and its run against the
 oracle on the short rolling scene."""
 

@@ -1,4 +1,4 @@
-"""The full reference agrees with the linearised model as α → 0 (issue 3, item 5).
+"""The full reference agrees with the linearised model as α → 0.
 
 Derivation of the expected order (details in reference/linear/alpha.py).  Scale the
 linear initial state by ε: φ = O(ε²) (so α = O(ε²)), ω, v = O(ε), and times are O(ε).

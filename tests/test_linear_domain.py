@@ -1,4 +1,4 @@
-"""The linear model reports leaving its small-tilt domain (issue 34, item 5): status
+"""The linear model reports leaving its small-tilt domain: status
 `left_model`, cut where the tilt reaches reference.linear.domain.TILT_LIMIT."""
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def test_a_tilt_growing_in_flight_ends_left_model_at_the_analytic_time():
 
 
 def test_a_diagonal_tilt_through_a_contact_phase_is_cut_where_it_reaches_the_limit():
-    """The three-point disk on tiny bumps tips over slowly (issue 34's probe): cut where
+    """The three-point disk on tiny bumps tips over slowly: cut where
     |φ| = TILT_LIMIT, with every sample before within it."""
     scene = resolve_scene("three-point-disk")
     scene = scene_from_dict(

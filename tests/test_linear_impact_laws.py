@@ -1,4 +1,4 @@
-"""The linear model under the exact reference's impact laws (issue 31; reference/linear/laws.py)."""
+"""The linear model under the exact reference's impact laws (reference/linear/laws.py)."""
 
 import math
 

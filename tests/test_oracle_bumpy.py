@@ -1,4 +1,4 @@
-"""The oracle (tests/oracle) on the bumpy ground (issue 32): rim vertices on the plane and
+"""The oracle (tests/oracle) on the bumpy ground: rim vertices on the plane and
 bumps under the face at once.  Each kind's gap, normal velocity, normal acceleration and
 Jacobian row against finite differences of the closed-form flight; impacts of each kind
 against the single-impact law and the invariants it keeps; energy through an elastic run

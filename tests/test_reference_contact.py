@@ -168,8 +168,8 @@ def test_impact_ending_a_contact_phase_is_where_the_gap_is_zero():
 def test_chunk_cap_keeps_the_time_scale_of_a_body_passing_flat_while_moving():
     """horizon.local_time_cap: with the body flat at the bumps' height (L = |z| + a sin α
     = 0) and rising at ż = U, the cap is LOCAL_TIME_FRACTION √(L_reach/K) with
-    L_reach = U²/(2K), i.e. F·U/(√2 K) (not √(0/K) = 0, which made chunks of 1e-21 s
-    after impacts beside two held contacts); at rest it is F √(L/K) as before."""
+    L_reach = U²/(2K), i.e. F·U/(√2 K) (not √(0/K) = 0, which would make chunks of 1e-21 s
+    after impacts beside two held contacts); at rest it is F √(L/K)."""
     from reference.core.horizon import local_time_cap
     from reference.core.tolerances import LOCAL_TIME_FRACTION as F
 
@@ -220,7 +220,7 @@ def test_a_rod_released_at_rest_on_one_vertex_falls_flat_at_the_energy_equations
     slides, the centre falls straight down (z = a sin θ) and θ̇² = 2g(sin θ0 − sin θ) /
     (a (cos²θ + ρ²)); vertex 1 lands at T = ∫₀^θ0 dθ/θ̇ (quadrature, independent), where
     the paper's rule stops (both vertices down).  A start with every velocity exactly 0
-    used to fail at t = 0 ("step size below roundoff")."""
+    runs (it does not fail at t = 0 with "step size below roundoff")."""
     from scipy.integrate import quad
 
     from tests.test_impact_law_runs import _on_ground

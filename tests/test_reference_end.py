@@ -1,6 +1,6 @@
 """The end of a motion whose tilt decays below double precision's range: an explicit
-singularity, never an exception (two runs of the reference exponent map that used to
-divide by zero at α ≈ 4e-296)."""
+singularity, never an exception (two runs of the reference exponent map reach
+α ≈ 4e-296, where a division by the tilt would divide by zero)."""
 
 import numpy as np
 import pytest
@@ -42,7 +42,7 @@ def test_a_tilt_decaying_below_the_floor_ends_at_the_singularity(name):
     )
     # the energy floor off (1e-300): the tilt floor, or for γ = 0 the contacts all
     # landing, ends the run (which of the two comes first is decided by roundoff along
-    # the chaotic γ = 0 run; both are the singularity; measured now: all contacts down
+    # the chaotic γ = 0 run; both are the singularity; measured: all contacts down
     # at α ≈ 9e-58, so that case covers the end of the run, not the floor itself)
     traj = simulate(scene, options=ReferenceOptions(energy_floor=1e-300))
     assert traj.status is Status.SINGULARITY
@@ -90,8 +90,8 @@ def test_released_contacts_whose_gaps_still_fall_land_and_the_run_ends():
     chatter completion the LCP releases contacts at zero gap, rate and acceleration
     whose gaps still fall (the spin's jerk; a tie the acceleration-level LCP cannot
     see), so the chunk's crossing is located below the clock's resolution.  They land
-    (held with the others) and the run reaches the end of the motion; it used to cut
-    zero-length chunks forever.  How it ends there (vertices held: singularity, or the
+    (held with the others) and the run reaches the end of the motion, not zero-length
+    chunks for ever.  How it ends there (vertices held: singularity, or the
     last ones landing together: simultaneous) is decided at roundoff.  The independent
     oracle gives the same impacts and the same end time (measured: its 764 impact times
     within 1.1e-8 of the reference's, the separation of two chaotic runs); energy never

@@ -200,8 +200,8 @@ def test_circle_step_is_within_its_tolerance_below_the_circle_bound_root(seed):
     """The circle step of a 1000-gon lies below the first root of its bound F and within
     CIRCLE_STEP_REL_TOL of it (root by scipy's brentq on F written out), the rim 1e-13
     … 1e-2 above the ground, spinning fast or tumbling, falling or rising.  A root
-    within roundoff of the bracket's far end used to hold the chords there and end
-    the solve at 0 after 100 evaluations."""
+    within roundoff of the bracket's far end is found too (chords held there would end
+    the solve at 0 after 100 evaluations)."""
     from scipy.optimize import brentq
 
     from reference.core.contacts import rim_jet
@@ -287,8 +287,8 @@ def test_others_safe_time_ends_before_any_other_contact_reaches_the_ground():
 def test_a_polygon_rolling_down_its_vertices_finds_each_impact_in_the_first_search_step():
     """A 100-gon spinning fast, tilted, γ = 0.5: its vertices hit one after another, each
     with the last one still touching and moving away.  The bracket shortcut certifies
-    the others until the next vertex's zero from the first search step (it used to
-    wait a step for the last vertex to lift off, one per impact): under 0.5 per
+    the others until the next vertex's zero from the first search step (not a step later, once
+    the last vertex has lifted off, one per impact): under 0.5 per
     impact, where every-vertex and window searches agree on the impacts."""
     import math
 

@@ -1,7 +1,7 @@
 """`harness report` refuses what is not a valid result document of its kind (one line
 naming the field, exit 2, nothing written), links only to http(s) URLs and relative
 files, and escapes every string; text from files reaches the terminal escaped; a BOM is
-accepted and a FIFO named as one (issue 34)."""
+accepted and a FIFO named as one."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The sweep store checks what it reads (issue 34): a part proves it belongs by its content
+"""The sweep store checks what it reads: a part proves it belongs by its content
 hash and its own parameters; damaged, foreign, off-grid and duplicated parts are set
 aside (said in the text output) and their runs recomputed; a lost manifest is never
 trusted over the parts' own parameters."""

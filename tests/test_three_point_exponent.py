@@ -1,4 +1,4 @@
-"""The energy exponent on the three-point ground (issue 31, item 5): the level the motion
+"""The energy exponent on the three-point ground: the level the motion
 ends at, the time it ends, and c of the paper's three-bump model (section 4.3)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The transition study (harness transition, issue 32): regimes from the contact kinds
+"""The transition study (harness transition): regimes from the contact kinds
 that act, their figures on a MuJoCo run of the short rolling scene, the takeover tilt
 against the face's geometric reach, and the command's refusals."""
 

@@ -1,4 +1,4 @@
-"""Faults while writing (issue 34): a full disk, a lost permission, a writer thread that
+"""Faults while writing: a full disk, a lost permission, a writer thread that
 never finishes, a run killed mid-write.  Each ends with exit 2 and one line naming the
 path and the cause, and nothing under the final name."""
 

@@ -1,5 +1,5 @@
 """Which branch a run follows after the reference's first undecidable state, and how
-far it stays with it (issue 31, item 4: `harness compare`).
+far it stays with it (`harness compare`).
 
 The reference under the paper's rule stops `simultaneous_impact` at t_u;
 harness.branches.spread continues it under every law (the branches b).  A run (an

@@ -1,4 +1,4 @@
-"""The branches of a scene at its first undecidable state (issue 31, item 4).
+"""The branches of a scene at its first undecidable state (`harness branches`).
 
 The reference runs the scene under the paper's rule; where it stops
 `simultaneous_impact` (at t_u, contacts C touching) each branch runs the same scene

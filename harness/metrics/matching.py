@@ -95,7 +95,8 @@ def match_tolerance(run: Trajectory, reference: Trajectory, gravity: float) -> M
     - 1e-2·t: errors in impact times accumulate.  A restitution error δ changes each
       following flight time by the relative amount δ, so after time t the impacts drift
       by about δ·t.  1 % is the acceptance level for an engine's effective restitution
-      (issue 4), so a run that passes that test is not declared diverged by drift alone.
+      (docs/engines.md, "The restitution contract"), so a run that passes that test is
+      not declared diverged by drift alone.
     Event-driven runs (dt None: reference, linear): 1e-9 s + 1e-2·t.  The absolute part
     is event-location roundoff; the relative part gives the linear model room for its
     linearisation error, which is O(α) relative in time (terms of order ω² ~ α against

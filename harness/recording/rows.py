@@ -18,8 +18,8 @@ Entities (/<sim> = one simulator):
     /<sim>/divergence/{log10_alpha,heading,log10_excess}   a red × on each row's curve at
                                     the run's first divergence from the reference
 
-rerun 0.41 has no logarithmic plot axis (rerun issue #6773), so the logarithmic rows
-carry log10 of the value and say so in their names.
+rerun 0.41 has no logarithmic plot axis (github.com/rerun-io/rerun/issues/6773), so the
+logarithmic rows carry log10 of the value and say so in their names.
 """
 
 from __future__ import annotations

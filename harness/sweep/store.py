@@ -175,7 +175,7 @@ class SweepStore:
         return self
 
     def _open_locked(self) -> None:
-        for tmp in self.parts_dir.glob(".tmp-*"):  # temporaries of earlier versions
+        for tmp in self.parts_dir.glob(".tmp-*"):  # .tmp-*: an unfinished part, never read
             tmp.unlink(missing_ok=True)
         for folder in (self.root, self.dir, self.parts_dir):  # a run killed mid-write
             remove_stale_temporaries(folder)

@@ -1,4 +1,4 @@
-"""The transition study (issue 32, `harness transition`): a spinning polygon rolling on
+"""The transition study (`harness transition`): a spinning polygon rolling on
 its rim over a bumpy floor, followed to the end; its regimes (rim only, mixed, bumps
 only), their exponents and the tilt at which the bumps take over, against the paper's
 estimate α ≈ Δ/d.  Modules: `scene` (the study's scene in the paper's units),

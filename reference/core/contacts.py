@@ -243,7 +243,7 @@ def reached_together(gap, rate, noise, tres0, rate0, window_per_speed):
     (the model cannot order them) plus the simultaneity window on the motion's scale,
     T |rate0|/U (model.window_per_speed = T/U, U the scene's velocity unit; T = 0:
     strictly sequential).  Scaled by the speed, the window keeps apart the late impacts
-    of a cascade, whose intervals shrink with the speeds (docs/architecture.md)."""
+    of a cascade, whose intervals shrink with the speeds (docs/laws.md, "The simultaneity window")."""
     window = window_per_speed * abs(rate0)
     return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0) + window
 

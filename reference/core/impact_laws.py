@@ -1,4 +1,4 @@
-"""Impact laws for several touching contacts at once (paper §2.3 generalised; issue 31).
+"""Impact laws for several touching contacts at once (paper §2.3 generalised).
 
 Plain functions of plain data: the k touching contacts enter only through their
 Delassus matrix W = J M⁻¹ Jᵀ (k × k, symmetric positive semi-definite: an impulse
@@ -37,7 +37,7 @@ Laws (`LAW_*`; their names in `LAW_NAMES`):
   turn: the orders of `harness branches`).  At most MAX_SEQUENTIAL_IMPACTS single
   impacts; beyond, status NOT_SETTLED.
 
-No energetic law (Darboux–Keller, Stronge, LZB): see docs/architecture.md, "Impact
+No energetic law (Darboux–Keller, Stronge, LZB): see docs/laws.md, "The
 laws" (not exact in closed form: an ODE in the impulse with switching, and LZB needs
 contact stiffness ratios the rigid model has no value for).
 """

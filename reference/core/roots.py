@@ -253,7 +253,7 @@ def zero_bracket_end(g, g1, g2, K, B):
 
 @hot
 def _decreasing_until(g1, g2, K, B, end):
-    """Whether a gap with rate g1 < 0, acceleration g2 and |g″| ≤ K, |g‴| ≤ B now is
-    still decreasing at every time up to `end`: its rate is at most g1 + Kδ and
+    """Whether a gap with rate g1 < 0, acceleration g2 and |g″| ≤ K, |g‴| ≤ B at the
+    start is still decreasing at every time up to `end`: its rate is at most g1 + Kδ and
     g1 + g2 δ + B δ²/2 (convex in δ), so it suffices that either is negative at end."""
     return g1 + K * end < 0.0 or g1 + end * (g2 + 0.5 * B * end) < 0.0

@@ -8,7 +8,7 @@ positive root of one; roots are taken in cancellation-free form (`first_hit`).  
   held at that moment must come out separating or resting (paper §2.3), otherwise the
   impact is undecidable, as are two contacts reached at once (status SIMULTANEOUS);
 - accumulation of a chatter sequence (Zeno), completed in closed form (below);
-- with a simultaneity window T > 0 (issue 31), open contacts reaching the ground
+- with a simultaneity window T > 0, open contacts reaching the ground
   within T of the one reached first are reached together with it: status SIMULTANEOUS
   (REASON_WINDOW) on the state where the first is reached, the others flagged in
   `together` (their gaps, at most T|u|, not closed); an impact law resolves it
@@ -494,11 +494,11 @@ def _impacts_now(F, q, p, qs, ps, closed, vfl):
 
 @njit(cache=True)
 def law_contacts(F, q, p, qs, ps, vfl, out):
-    """The contacts of a simultaneous impact under an impact law (issue 31): every
+    """The contacts of a simultaneous impact under an impact law: every
     contact touching the ground within roundoff and not separating beyond it (normal
     velocity f_cᵀp ≤ its roundoff level), into out; returns how many.  Held contacts
     (resting) are in, a contact leaving is not: a law's impulse on a separating contact
-    could do positive work (docs/architecture.md, "Impact laws")."""
+    could do positive work (docs/laws.md, "The laws")."""
     n = 0
     for c in range(F.shape[0]):
         if _touching(F, c, q, qs) and _dot(F, c, p) <= _tol(F, c, ps, vfl):
@@ -1009,7 +1009,7 @@ def _flight_step(model, limits, state, scratch, out, si, sf, info, vfl):
 
 @_helper
 def _reached_together(F, q, p, qs, ps, acc, closed, vfl, jmin, t_window, together):
-    """The simultaneity window (issue 31): the open contacts other than jmin that reach
+    """The simultaneity window: the open contacts other than jmin that reach
     the ground by t_window (normalised) are reached together with it; they and jmin are
     flagged in `together` (cleared first).  Returns one of them, −1 if none."""
     other = -1

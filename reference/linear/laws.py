@@ -1,5 +1,5 @@
 """The linear model past undecidable states, under the exact reference's impact laws
-(issue 31; the exact core's counterpart is reference/continuation.py).
+(docs/laws.md; the exact core's counterpart is reference/continuation.py).
 
 The linear kernel applies the paper's rule: where several contacts touch at an impact
 (two reached at once, an impact that would push a held contact, a contact at the ground

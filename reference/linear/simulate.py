@@ -146,7 +146,7 @@ def run_linear(
     `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
     or `moreau` / `sequential`: the run goes on past it under that law (laws.py).
     `simultaneity_window`: open contacts reaching the ground within this time of the
-    first are reached together with it (0: strictly sequential, as before issue 31)."""
+    first are reached together with it (0: strictly sequential)."""
     if impact_law != "paper":
         from .laws import run_under_law
 
@@ -316,8 +316,8 @@ def simulate_linear(
     from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
     max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
     listed in stats["accumulations"], not as impacts.  The scene's `impact_law` and
-    `simultaneity_window` apply (laws.py; docs/architecture.md, "The linear model under
-    the laws")."""
+    `simultaneity_window` apply (laws.py; docs/laws.md, "The linear model under the
+    laws")."""
     from ..checks import check_linear_options, run_horizon
     from ..scenes import as_scene
     from .exponent_estimates import extrapolate_time_to_go

@@ -10,7 +10,7 @@ Contacts (docs/architecture.md, "The model"):
   face (plane through the centre of mass with normal e3 = R ẑ) touches it;
   gap = (x − b_k)·e3; normal e3; lever r_k = in-plane projection of b_k − x.
 
-- `bumpy` (issue 32): both at once, the n vertices on the plane z = 0 first (contacts
+- `bumpy`: both at once, the n vertices on the plane z = 0 first (contacts
   0 … n−1, as on `flat`), then the bumps under the face (contacts n …, as on
   `three_point`), bump j at (x_j, y_j, h_j) above the plane.
 

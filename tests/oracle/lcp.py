@@ -1,7 +1,7 @@
 """Oracle: Moreau's frictionless impact law over k touching contacts, by enumeration.
 
-0 ≤ Λ ⊥ w = q + WΛ ≥ 0 with q = u⁻ + γ min(u⁻, 0), W = J M⁻¹ Jᵀ (docs/architecture.md,
-"Impact laws").  Every support A ⊆ {0..k−1} is tried: the least-squares (minimum-norm)
+0 ≤ Λ ⊥ w = q + WΛ ≥ 0 with q = u⁻ + γ min(u⁻, 0), W = J M⁻¹ Jᵀ (docs/laws.md,
+"The laws").  Every support A ⊆ {0..k−1} is tried: the least-squares (minimum-norm)
 solution of W_AA Λ_A = −q_A is a solution of the LCP when the system is consistent,
 Λ_A ≥ 0 and w ≥ 0 off A.  All solutions found must give the same u⁺ (the law's
 uniqueness); the least-norm impulses are then the smallest of the minimum-norm
