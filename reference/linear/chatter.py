@@ -226,8 +226,7 @@ def format_chatter(doc: dict) -> str:
     """The eigenvalues, CC/PCC, the rod's thresholds and the self-similar pairs, then
     its legend (CHATTER_LEGEND, without the parts describing what is not printed)."""
     lines = [
-        f"chatter (no gravity): n = {doc['n']}, ρ = {doc['gyration']}, "
-        f"γ = {doc['restitution']}",
+        f"chatter (no gravity): n = {doc['n']}, ρ = {doc['gyration']}, γ = {doc['restitution']}",
         "eigenvalues of R^-1 U0: "
         + ", ".join(f"{re:.6g}{im:+.6g}i" if im else f"{re:.9g}" for re, im in doc["eigenvalues"]),
         f"CC  {'yes' if doc['cc'] else 'no'}    PCC  {'yes' if doc['pcc'] else 'no'}",
