@@ -69,7 +69,7 @@ def build_parser(argv: list[str] | None = None) -> Parser:
     p = Parser(prog=PROGRAM, description=__doc__.splitlines()[0])
     p.add_argument("--version", action=VersionAction)
     add_verbose(p, top=True)
-    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser, metavar="COMMAND")
     wanted = _command_named(argv)
     for command in COMMANDS:
         try:
