@@ -86,3 +86,14 @@ def test_simulate_says_it_was_scaled_and_names_both_files_it_writes(tmp_path, ca
     stdout, stderr = capsys.readouterr()
     assert "scaled      by ε = 0.0001: q × ε² = 1e-08, p × ε = 0.0001" in stdout
     assert f"wrote {out} (samples) and {tmp_path / 'run.impacts.parquet'} (impacts)" in stderr
+
+
+def test_branches_names_contacts_as_the_tables_do(capsys):
+    import re
+
+    assert main(["branches", "triangle-chatter"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"t_u = \S+ s, contacts v\d, v\d\n", out), out
+    moreau = next(line for line in out.splitlines() if line.startswith("moreau "))
+    assert re.search(r" v\d v\d .* v\d \+\S+ s ", moreau), moreau
+    assert max(len(line) for line in out.splitlines()) <= 100
