@@ -136,10 +136,11 @@ def run_steps(
                 return LoopResult(Status.FAILED, message, done, stepping)
             if rows.broken is not None:
                 return LoopResult(Status.FAILED, rows.broken, done, stepping)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:  # Ctrl-C, or the harness's SIGTERM (a subclass)
         if t0 is not None:  # interrupted inside advance
             stepping += time.perf_counter() - t0
         t_last = stepper.settle()
-        message = f"interrupted (Ctrl-C) at t = {t_last:.6g}; the steps before are kept"
+        reason = getattr(exc, "reason", "interrupted (Ctrl-C)")
+        message = f"{reason} at t = {t_last:.6g}; the steps before are kept"
         return LoopResult(Status.FAILED, message, done, stepping, interrupted=True)
     return LoopResult(status, message, done, stepping)

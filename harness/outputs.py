@@ -37,6 +37,8 @@ from pathlib import Path
 
 from reference.scene import show_path as show
 
+from . import signals
+
 TEMP_PREFIX = ".harness-tmp-"
 # A path component longer than this (bytes) is refused where os.pathconf cannot tell.
 DEFAULT_NAME_MAX = 255
@@ -128,6 +130,7 @@ def atomic_outputs(paths: Sequence[str | os.PathLike], force: bool = False) -> I
             os.fchmod(fd, _mode_for(target))  # mkstemp makes it private (0600)
             os.close(fd)
         yield list(tmps)
+        signals.raise_if_received()  # a swallowed SIGTERM or Ctrl-C: nothing moves in place
         for tmp in tmps:
             _sync(tmp)
         for tmp, target in zip(tmps, targets, strict=True):

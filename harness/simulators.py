@@ -156,8 +156,11 @@ def run_simulator(
     reaches engines that report progress (their `reports_progress` attribute).  After
     the run, harness.guard: a sample that is no valid state (NaN, a quaternion far from
     unit norm, a body through the ground) ends the run `failed` there.  An engine that
-    raises (e.g. MuJoCo refusing a mass below its 1e-15 floor) gives a `failed` run with
-    the error as its message and the traceback's end in stats["error"]."""
+    raises once its inputs passed `check_run` (e.g. MuJoCo refusing a mass below its
+    1e-15 floor, a plug-in raising SceneError for a scene it does not take) gives a
+    `failed` run with the error as its message and the traceback's end in
+    stats["error"]: one engine's failure is its own rows' status, never the end of a
+    study over several engines."""
     from reference.scenes import as_scene
 
     from .guard import guard_trajectory
@@ -170,9 +173,7 @@ def run_simulator(
         extra["progress"] = progress
     try:
         traj = simulate(scene, dt=step, t_end=t_end, **extra)
-    except SceneError:
-        raise
-    except Exception as exc:  # the engine broke on this scene: a result, not a crash
+    except Exception as exc:  # the engine broke on (or refused) this scene: a result
         traj = Trajectory.failed(
             engine, scene.name, step, f"{engine} raised {type(exc).__name__}: {exc}"
         )
@@ -188,6 +189,27 @@ def _error_text(exc: BaseException, limit: int = 2000) -> str:
 
     text = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__, limit=-4))
     return text.strip()[-limit:]
+
+
+# The simulators that resolve simultaneous impacts under an impact law and a window.
+LAW_ENGINES = ("reference", "linear")
+
+
+def check_law_options(engine: str, impact_law: str | None, window: float | None) -> None:
+    """SceneError (exit 2) when --impact-law or --simultaneity-window is given for an
+    engine that does not read them (every engine but LAW_ENGINES resolves contacts with
+    its own solver): an option is applied or refused, never silently ignored."""
+    given = [
+        name
+        for name, value in (("--impact-law", impact_law), ("--simultaneity-window", window))
+        if value is not None
+    ]
+    if given and engine not in LAW_ENGINES:
+        verb = "applies" if len(given) == 1 else "apply"
+        raise SceneError(
+            f"{' and '.join(given)} {verb} to the {' and '.join(LAW_ENGINES)} engines only; "
+            f"{engine} resolves its contacts with its own solver"
+        )
 
 
 def engine_step(engine: str, dt: float | None) -> float | None:

@@ -7,7 +7,8 @@ it stops with `simultaneous_impact`, on the state just before that impact.  Unde
 `moreau` or `sequential` law the run goes on from there (`continue_run`):
 
 1. the contacts of the impact: every contact touching (gap within roundoff of the
-   ground, `touching_contacts`) and not separating;
+   ground, `touching_contacts`) and not separating (under `compliant`, the separating
+   ones too: the others can push them back);
 2. the law's impulses on them (reference.core.multi_impact, the laws of
    reference.core.impact_laws), one impact row per contact that took an impulse, all at
    the impact's time;
@@ -62,17 +63,20 @@ class LawImpact:
     completed: bool = False  # the bounces were small: completed (taken plastic)
 
 
-def touching_contacts(scene, y: np.ndarray, always: list[int]) -> np.ndarray:
+def touching_contacts(
+    scene, y: np.ndarray, always: list[int], separating: bool = False
+) -> np.ndarray:
     """Contacts touching the ground at state y and not separating: gap ≤ TOUCH_ULPS ε
     (|z| + a) and normal velocity ≤ its roundoff, plus `always` (the contacts the loop
-    named)."""
+    named); `separating`: the touching ones that separate too (the compliant law, in
+    which the others can push them back)."""
     gap, vn = contact_kinematics(y, scene.contacts)
     gap, vn = gap[0], vn[0]
     a = scene.body.radius
     gap_tol = TOUCH_ULPS * EPS * (abs(y[L.Z]) + a)
     v_scale = np.linalg.norm(y[L.VELOCITY]) + a * np.linalg.norm(y[L.ANGULAR_VELOCITY])
     v_tol = RATE_NOISE_ULPS * EPS * v_scale
-    mask = (gap <= gap_tol) & (vn <= v_tol)
+    mask = (gap <= gap_tol) & ((vn <= v_tol) | separating)
     mask[list(always)] = True
     return np.flatnonzero(mask)
 
@@ -100,7 +104,10 @@ def apply_law(
         ordered += [i for i in range(k) if i not in ordered]
     order_idx = np.array(ordered, dtype=np.int64)
     W, chol = np.zeros((k, k)), np.zeros((k, k))
-    u_pre, lam, u_post, vec = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(2 * k)
+    u_pre, lam, u_post = np.zeros(k), np.zeros(k), np.zeros(k)
+    from .core.compliant import work_size  # here: the compiled core imports numba
+
+    vec = np.zeros(max(2 * k, work_size(k)))  # the laws' scratch (compliant's the largest)
     active, result = np.zeros(k, dtype=np.int64), np.zeros(3, dtype=np.int64)
     function("multi_impact")(
         y, model_record(scene), pts, LAW_NAMES.index(law), cs, k, order_idx, len(order_idx),
@@ -179,7 +186,9 @@ def continue_run(
         if same_time >= MAX_RESTARTS_AT_ONE_TIME:
             return f"the {law} law made no progress at t = {t_hi:.17g}: stopped (undecidable)"
         y = np.array(st["y"][0], dtype=float)
-        contacts = touching_contacts(scene, y, law_contacts(st[0]))
+        contacts = touching_contacts(
+            scene, y, law_contacts(st[0]), separating=law.startswith("compliant")
+        )
         impact = apply_law(scene, y, contacts, law, order, chatter_tol)
         if impact.status == NOT_SETTLED:
             return (

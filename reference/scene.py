@@ -16,7 +16,10 @@ alone when g = 0), with the velocity unit U = a/τ = max(√(g a), a/t_end):
   1e±12 of 1 the smaller keeps four of its sixteen digits;
 - 2 ≤ n ≤ MAX_VERTICES: beyond, the polygon differs from its circle by
   a (1 − cos π/n) < 5e-12 a; the per-vertex arrays cost O(n) memory;
-- bump_radius / a in [MIN_BUMP_RADIUS, 1);
+- bump_radius / a in [MIN_BUMP_RADIUS, 1); listed bumps at least MIN_BUMP_SPACING a
+  apart in the plane (coincident bumps make a singular impact problem);
+- simultaneity_window at most MAX_WINDOW_TIME_UNITS time units a/V = √(a/g)
+  (check_window_bound: a wider window merges a contact's later bounces);
 - speed group (|v| + |ω| a) / U ≤ MAX_SPEED, i.e. v²/(g a) and ω² a/g ≤ 1e6: the
   reference's tolerances follow the body's velocity scale V (velocity noise 64 ε V,
   chatter completed below 1e-6 V), and on flat ground the horizontal velocity and the
@@ -59,6 +62,10 @@ DIMENSION_RANGE = (1e-50, 1e50)
 GYRATION_RANGE = (1e-6, 1e6)
 MAX_VERTICES = 1_000_000
 MIN_BUMP_RADIUS = 1e-6
+# Least distance in the plane between two bumps, in body radii: the resolution of
+# MIN_BUMP_RADIUS (closer bumps make nearly equal contact rows, whose complementarity
+# problem loses more digits than the 1e-12 relative the impact law keeps).
+MIN_BUMP_SPACING = MIN_BUMP_RADIUS
 # three_point ground: the floor plane lies this far below the bumps' tops, in body radii,
 # unless [ground] floor_depth says (a model limit, not a contact: reference.core.floor).
 # A tenth of the radius: a disk held on a bump at b = a/2 reaches it at a tilt of about
@@ -68,7 +75,7 @@ MAX_SPEED = 1e3
 MAX_POSITION = 1e6
 MAX_ROTATION_VECTOR = 1e3
 # the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
-IMPACT_LAWS = ("paper", "moreau", "sequential")
+IMPACT_LAWS = ("paper", "moreau", "sequential", "compliant", "compliant-mass")
 DEFAULT_IMPACT_LAW = "paper"
 # the exact reference's simultaneity window [time unit of the scene] under `moreau` and
 # `sequential` when neither the scene nor the options set one (under `paper`: 0,
@@ -81,6 +88,8 @@ DEFAULT_IMPACT_LAW = "paper"
 DEFAULT_SIMULTANEITY_WINDOW = 1e-11
 SCALE_RANGE = (1e-50, 1e50)
 MAX_IMPACTS = 10_000_000
+# The widest simultaneity window, in time units a/V (check_window_bound)
+MAX_WINDOW_TIME_UNITS = 1.0
 MAX_SCENE_FILE_BYTES = 1 << 20
 MAX_NAME_LENGTH = 200
 
@@ -346,11 +355,9 @@ def scene_from_dict(data: dict[str, Any], default_name: str = "scene") -> Scene:
         raise SceneError(f"a scene is a TOML table, got {type(data).__name__}")
     _check_keys("scene", data, _TOP_KEYS)
     gravity = _number("gravity", data.get("gravity", 1.0))
-    if gravity != 0.0:
-        _check_in_range("gravity", gravity, DIMENSION_RANGE, zero_ok=True)
+    _check_gravity(gravity)
     gamma = _number("restitution", data.get("restitution", 0.5))
-    if not 0.0 <= gamma <= 1.0:
-        raise SceneError(f"restitution must be in [0, 1], got {gamma}")
+    _check_restitution(gamma)
     body = _parse_body(_table("body", data))
     scene = Scene(
         name=_text("name", data.get("name", default_name)),
@@ -379,11 +386,12 @@ def check_impact_law(law: Any) -> str:
     return law
 
 
-def check_window(window: float) -> float:
+def check_window(window: Any) -> float:
     """A simultaneity window: a finite time >= 0 (0: strictly sequential)."""
-    if not (math.isfinite(window) and 0.0 <= window <= DIMENSION_RANGE[1]):
+    w = _number("simultaneity_window", window)
+    if not 0.0 <= w <= DIMENSION_RANGE[1]:
         raise SceneError(f"simultaneity_window must be a finite time >= 0, got {window!r}")
-    return float(window)
+    return w
 
 
 def _parse_body(b: dict) -> Body:
@@ -391,10 +399,7 @@ def _parse_body(b: dict) -> Body:
     if "n" not in b:
         raise SceneError("[body] needs n (number of vertices, >= 2)")
     n = b["n"]
-    if isinstance(n, bool) or not isinstance(n, int):
-        raise SceneError(f"body.n must be an integer, got {n!r}")
-    if not 2 <= n <= MAX_VERTICES:
-        raise SceneError(f"body.n must be in [2, {MAX_VERTICES}] (2 is the rod), got {n}")
+    _check_vertices(n)
     return Body(
         n=n,
         radius=_in_range("body.radius", b.get("radius", 1.0), DIMENSION_RANGE),
@@ -423,13 +428,7 @@ def _parse_ground(gr: dict, body: Body) -> Ground:
             )
         return Ground(kind=kind, bumps=_parse_bumps(gr["bumps"], body.radius))
     bump = _number("ground.bump_radius", gr.get("bump_radius", 0.5 * body.radius))
-    if kind != "flat" and not MIN_BUMP_RADIUS <= bump / body.radius < 1.0:
-        raise SceneError(
-            f"ground.bump_radius must be in [{MIN_BUMP_RADIUS:g}, 1) x body.radius "
-            f"({body.radius:g}), got {bump:g}"
-        )
-    if kind == "flat" and not bump > 0:
-        raise SceneError(f"ground.bump_radius must be > 0, got {bump!r}")
+    _check_bump_radius(bump, kind, body.radius)
     if kind == "bumpy":
         height = _number("ground.bump_height", gr.get("bump_height", 0.0))
         _check_bump_height("ground.bump_height", height, body.radius)
@@ -471,7 +470,24 @@ def _parse_bumps(value: Any, radius: float) -> tuple[tuple[float, float, float],
             )
         _check_bump_height(f"ground.bumps[{j}] height", h, radius)
         out.append((x, y, h))
+    _check_distinct_bumps(out, radius)
     return tuple(out)
+
+
+def _check_distinct_bumps(bumps, radius: float) -> None:
+    """No two bumps closer than MIN_BUMP_SPACING × body.radius in the plane: the face
+    touches both at one point of its own, so their contact rows coincide (a singular
+    complementarity problem: every impact law fails there), and the lower of two
+    coincident bumps can never be reached."""
+    for j, (xj, yj, _) in enumerate(bumps):
+        for k in range(j):
+            xk, yk, _ = bumps[k]
+            if math.hypot(xj - xk, yj - yk) < MIN_BUMP_SPACING * radius:
+                raise SceneError(
+                    f"ground.bumps[{j}] coincides with ground.bumps[{k}] (closer than "
+                    f"{MIN_BUMP_SPACING:g} x body.radius in the plane): each bump must "
+                    "stand at its own place under the face"
+                )
 
 
 def _check_bump_height(name: str, h: float, radius: float) -> None:
@@ -517,10 +533,131 @@ def _parse_run(r: dict) -> RunSettings:
 
 
 def check_scene(scene: Scene) -> None:
-    """The checks that involve several fields: the initial state within what the
-    method resolves (position, attitude, the speed group) and not below the ground."""
+    """The one check of a scene, however it was built (a file, `scene_from_dict`,
+    `dataclasses.replace`, the constructors): every field's type and range
+    (`check_fields`, the ranges of the module docstring), then the checks that involve
+    several fields: the initial state within what the method resolves (position,
+    attitude, the speed group) and not below the ground."""
+    check_fields(scene)
     check_initial_state(scene)
     check_not_below_ground(scene)
+
+
+def check_fields(scene: Any) -> None:
+    """SceneError unless `scene` is a Scene whose every field has the type and range a
+    scene file's key must have (the same rules and messages as the file's keys)."""
+    if not isinstance(scene, Scene):
+        raise SceneError(f"a Scene is needed (reference.scene), got {type(scene).__name__}")
+    _text("name", scene.name)
+    _text("description", scene.description)
+    _check_gravity(_number("gravity", scene.gravity))
+    _check_restitution(_number("restitution", scene.restitution))
+    _check_body(scene.body)
+    _check_ground(scene.ground, scene.body)
+    _check_initial_fields(scene.initial)
+    if not isinstance(scene.run, RunSettings):
+        raise SceneError(f"run must be a RunSettings, got {type(scene.run).__name__}")
+    check_t_end(scene.run.t_end)
+    _check_max_impacts(scene.run.max_impacts)
+    check_impact_law(scene.impact_law)
+    if scene.simultaneity_window is not None:
+        check_window_bound(scene, check_window(scene.simultaneity_window))
+
+
+def _check_gravity(g: float) -> None:
+    """g = 0 (no gravity) or in DIMENSION_RANGE: a negative g would pull the body up
+    through the plane it stands on."""
+    if g != 0.0:
+        _check_in_range("gravity", g, DIMENSION_RANGE, zero_ok=True)
+
+
+def _check_restitution(gamma: float) -> None:
+    """0 ≤ γ ≤ 1: γ > 1 would create energy at every impact."""
+    if not 0.0 <= gamma <= 1.0:
+        raise SceneError(f"restitution must be in [0, 1], got {gamma}")
+
+
+def _check_vertices(n: Any) -> None:
+    if isinstance(n, bool) or not isinstance(n, int):
+        raise SceneError(f"body.n must be an integer, got {n!r}")
+    if not 2 <= n <= MAX_VERTICES:
+        raise SceneError(f"body.n must be in [2, {MAX_VERTICES}] (2 is the rod), got {n}")
+
+
+def _check_body(body: Any) -> None:
+    if not isinstance(body, Body):
+        raise SceneError(f"body must be a Body, got {type(body).__name__}")
+    _check_vertices(body.n)
+    _in_range("body.radius", body.radius, DIMENSION_RANGE)
+    _in_range("body.mass", body.mass, DIMENSION_RANGE)
+    _in_range("body.gyration", body.gyration, GYRATION_RANGE)
+
+
+def _check_ground(ground: Any, body: Body) -> None:
+    """The [ground] keys' rules (`_parse_ground`) on a Ground value."""
+    if not isinstance(ground, Ground):
+        raise SceneError(f"ground must be a Ground, got {type(ground).__name__}")
+    kind = ground.kind
+    if kind not in GROUND_KINDS:
+        raise SceneError(f"ground.kind must be 'flat', 'three_point' or 'bumpy', got {kind!r}")
+    a = body.radius
+    if kind != "bumpy" and (ground.bump_height != 0.0 or ground.bumps is not None):
+        raise SceneError("ground.bump_height and ground.bumps belong to kind = 'bumpy'")
+    if kind != "three_point" and ground.floor_depth is not None:
+        raise SceneError("ground.floor_depth belongs to kind = 'three_point'")
+    if ground.bumps is not None:
+        _parse_bumps(
+            [list(b) if isinstance(b, (list, tuple)) else b for b in _seq(ground.bumps)], a
+        )
+        return
+    _check_bump_radius(_number("ground.bump_radius", ground.bump_radius), kind, a)
+    _check_bump_height("ground.bump_height", _number("ground.bump_height", ground.bump_height), a)
+    if ground.floor_depth is not None:
+        _floor_depth(ground.floor_depth, a)
+
+
+def _seq(value: Any) -> list:
+    if not isinstance(value, (list, tuple)):
+        raise SceneError(f"ground.bumps must be a list of 1 to {MAX_BUMPS} [x, y, height]")
+    return list(value)
+
+
+def _check_bump_radius(bump: float, kind: str, radius: float) -> None:
+    """b / a in [MIN_BUMP_RADIUS, 1) for the grounds with bumps; > 0 (unused) on flat."""
+    if kind != "flat" and not MIN_BUMP_RADIUS <= bump / radius < 1.0:
+        raise SceneError(
+            f"ground.bump_radius must be in [{MIN_BUMP_RADIUS:g}, 1) x body.radius "
+            f"({radius:g}), got {bump:g}"
+        )
+    if kind == "flat" and not bump > 0:
+        raise SceneError(f"ground.bump_radius must be > 0, got {bump!r}")
+
+
+def _check_initial_fields(ini: Any) -> None:
+    if not isinstance(ini, InitialState):
+        raise SceneError(f"initial must be an InitialState, got {type(ini).__name__}")
+    for name in ("position", "rotation_vector", "velocity", "angular_velocity", "q", "p"):
+        value = getattr(ini, name)
+        if value is not None or name not in ("q", "p"):
+            _vector(f"initial.{name}", list(value) if isinstance(value, tuple) else value)
+
+
+def check_window_bound(scene: Scene, window: float) -> float:
+    """A simultaneity window of at most MAX_WINDOW_TIME_UNITS time units a/V
+    (V = window_speed_unit: √(a/g) with gravity, t_end without).  A contact reached at
+    speed |u| merges the zeros within T |u|/V; with T ≤ a/V that is at most |u| a/V² =
+    |u|/g, the time of its own bounce.  A wider window merges zeros of later bounces
+    into one impact, which is no longer simultaneity, and the law's sequential work
+    grows without bound (measured on triangle-chatter under `sequential`: 3e9 ends in
+    0.3 s, 1e10 does not end)."""
+    limit = MAX_WINDOW_TIME_UNITS * time_unit(scene)
+    if window > limit:
+        raise SceneError(
+            f"simultaneity_window must be at most the motion's time unit a/V = {limit:.3g} "
+            f"(V = sqrt(g a), or a/t_end without gravity), got {window:g}: a wider window "
+            "merges a contact's later bounces into one impact"
+        )
+    return window
 
 
 def reference_window(scene: Scene, law: str | None = None) -> float:
@@ -547,6 +684,13 @@ def window_speed_unit(scene: Scene) -> float:
     shrink with the speeds, are never merged).  Without gravity: velocity_unit."""
     g, a = scene.gravity, scene.body.radius
     return math.sqrt(g * a) if g > 0 else velocity_unit(scene)
+
+
+def time_unit(scene: Scene) -> float:
+    """a/V (V = window_speed_unit): √(a/g), or t_end without gravity; the time of a
+    bounce at the speed unit, the scale on which the window and a run's progress are
+    judged."""
+    return scene.body.radius / window_speed_unit(scene)
 
 
 def velocity_unit(scene: Scene) -> float:

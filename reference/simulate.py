@@ -36,6 +36,7 @@ from .scene import (
     Scene,
     check_impact_law,
     check_window,
+    check_window_bound,
     reference_window,
     scene_from_dict,
     window_speed_unit,
@@ -228,7 +229,7 @@ def simulate(
     scene = as_scene(scene)
     opts = ReferenceOptions() if options is None else options
     t_end = run_horizon(scene, t_end)  # SceneError before any work (reference.checks)
-    check_reference_options(opts)
+    check_reference_options(opts, scene)
     law, window = impact_law_of(scene, opts)
     if (law, window) != (scene.impact_law, scene.simultaneity_window):
         scene = scene.with_impact_law(law, window)  # the options' choice, for the core
@@ -261,7 +262,7 @@ def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
         if opts.simultaneity_window is not None
         else reference_window(scene, law)
     )
-    return check_impact_law(law), check_window(window)
+    return check_impact_law(law), check_window_bound(scene, check_window(window))
 
 
 # A rough cost of compiling the loop just in time on a 2-core machine (measured).

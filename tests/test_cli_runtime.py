@@ -13,7 +13,7 @@ import pytest
 import engines.mujoco as M
 import engines.pybullet as PB
 from harness.cli import build_parser, main
-from reference.scene import Body, Ground, InitialState, RunSettings, Scene
+from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
 from tests.conftest import make_scene
 
 
@@ -81,10 +81,14 @@ def unresolvable_scene() -> Scene:
 
 
 def test_mujoco_warnings_go_to_the_run_not_to_stdout_or_a_log_file(monkeypatch, tmp_path, capfd):
-    from harness.simulators import run_simulator
+    from harness.guard import guard_trajectory
+    from harness.simulators import load_engine, run_simulator
 
     monkeypatch.chdir(tmp_path)
-    traj = run_simulator("mujoco", unresolvable_scene())
+    with pytest.raises(SceneError, match="initial speed"):  # the API checks it too
+        run_simulator("mujoco", unresolvable_scene())
+    scene = unresolvable_scene()  # handed to the adapter itself, past the checks
+    traj = guard_trajectory(scene, load_engine("mujoco")(scene, dt=1e-4, t_end=0.01))
     out, _ = capfd.readouterr()
     assert out == "" and list(tmp_path.iterdir()) == []  # no MUJOCO_LOG.TXT
     assert traj.status.value == "failed" and "non-finite" in traj.message

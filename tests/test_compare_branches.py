@@ -14,6 +14,7 @@ from harness.branches.follow import follow_branches
 from harness.branches.spread import branches
 from harness.cli import main
 from harness.compare import compare, format_compare
+from harness.compare.branch_text import branch_sentence
 from harness.scenes import resolve_scene
 from reference.trajectory import ImpactEvent
 from tests.test_impact_law_runs import STARTS, _on_ground
@@ -27,8 +28,9 @@ BRANCH_FIELDS = {
 
 @pytest.fixture(scope="module")
 def flat_triangle():
-    """A triangle starting flat on its three vertices: undecidable at t = 0, and eight
-    branches with different next impacts (the sequential law in each order)."""
+    """A triangle starting flat on its three vertices: undecidable at t = 0, and ten
+    branches (moreau, sequential, compliant, compliant-mass, the sequential law in each
+    order)."""
     n, rotation, velocity, omega = STARTS["three (a flat triangle)"]
     scene, _ = _on_ground(n, rotation, velocity, omega)
     return scene, branches(scene)
@@ -47,7 +49,7 @@ def _same_run(a, b) -> bool:
     )
 
 
-@pytest.mark.parametrize("which", range(8))
+@pytest.mark.parametrize("which", range(10))
 def test_a_run_made_of_one_branch_follows_that_branch_to_its_end(flat_triangle, which):
     scene, spread = flat_triangle
     built = spread.branches[which]
@@ -62,7 +64,8 @@ def test_a_run_made_of_one_branch_follows_that_branch_to_its_end(flat_triangle, 
     assert chosen.of == after and chosen.impacts + chosen.skipped == after
     assert chosen.until == pytest.approx(built.trajectory.t[-1])
     others = [c for c in follow.candidates if c.distance > chosen.distance]
-    assert all(c.impacts < chosen.impacts for c in others)
+    if chosen.of:  # a branch without impacts after t_u (compliant: it flies off) ties at 0
+        assert all(c.impacts < chosen.impacts for c in others)
 
 
 def test_the_sequential_law_in_its_own_order_is_one_branch(flat_triangle):
@@ -101,7 +104,12 @@ def _check_engine_branch(result, label):
     text = format_compare(result)
     assert max(len(line) for line in text.splitlines()) <= 100
     row = next(line for line in text.splitlines()[::-1] if line.startswith(label))
-    assert row.split()[2] == n.branch
+    if follow.followed_reference:
+        assert row.split()[2] == n.branch
+    else:  # it left the reference before t_u: no branch named
+        assert row == f"{label}: left the reference before t_u: no branch"
+        assert not follow.decided
+        assert branch_sentence(run) == f"{label} left the reference before t_u: no branch."
 
 
 def test_the_demo_scene_names_the_branch_mujoco_follows(demo):

@@ -137,7 +137,7 @@ def test_every_output_names_the_law(tmp_path, capsys):
     assert main(["branches", str(path), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     names = [b["branch"] for b in doc["branches"]]
-    assert names == ["paper", "moreau", "sequential"]  # six contacts: no orders
+    assert names == ["paper", "moreau", "sequential", "compliant", "compliant-mass"]  # no orders
     assert doc["undecidable"]["t"] == pytest.approx(1.0)
     assert doc["undecidable"]["contacts"] == list(range(6))
     moreau = doc["branches"][1]

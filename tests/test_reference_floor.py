@@ -144,14 +144,19 @@ def test_a_run_that_stays_above_the_floor_is_unchanged():
     assert (traj.position[:, 2] + 0.1 - np.sin(traj.inclination)).min() > 0.09
 
 
-def test_a_state_below_the_floor_is_refused_and_the_core_ends_it_at_the_start():
+def test_a_state_below_the_floor_is_refused_and_the_core_ends_it_at_the_start(monkeypatch):
     """A scene starting with its rim below the floor is bad input (like a contact below
-    the ground); a state that reaches the core anyway ends `left_model` at t = 0."""
+    the ground), from a file and through the API; a state that reaches the core anyway
+    (the API's check taken away) ends `left_model` at t = 0."""
     rest = {"velocity": [0, 0, 0], "angular_velocity": [0, 0, 0], "rotation_vector": [0, 0.8, 0]}
     with pytest.raises(SceneError, match="below the floor plane z = -0.1"):
         _scene({"position": [0.0, 0.0, 0.6], **rest})
     above = _scene({"position": [0.0, 0.0, 0.6], **rest}, floor_depth=0.2)
-    traj = simulate(replace(above, ground=replace(above.ground, floor_depth=0.1)))
+    below = replace(above, ground=replace(above.ground, floor_depth=0.1))
+    with pytest.raises(SceneError, match="below the floor plane z = -0.1"):
+        simulate(below)
+    monkeypatch.setattr("reference.checks.check_scene", lambda scene: None)
+    traj = simulate(below)
     assert traj.status is Status.LEFT_MODEL
     assert traj.t_final == 0.0
     assert "floor plane z = -0.1" in traj.message

@@ -63,8 +63,6 @@ def timed(setting: Setting, scene: Scene, t_end: float) -> tuple[Trajectory, flo
     start = time.perf_counter()
     try:
         traj = setting.run(scene, t_end)
-    except SceneError:
-        raise
     except Exception as exc:  # a broken simulator is a result
         traj = Trajectory.failed(
             setting.engine, scene.name, setting.dt, f"{type(exc).__name__}: {exc}"

@@ -31,10 +31,12 @@ order (s tails skipped on the way: k+s/N), until the first disagreement, or the 
 the common window when there is none; a branch that ends at the singularity is at rest
 from then on (`stays_until`): a run impact after that, faster than the chatter tails, is
 a disagreement (and counts as an extra impact in d_impacts), and a run without one stays
-with the branch to its own end.  The choice is *decided* when the next nearest
-branch of another distance is more than DECIDED_MARGIN (1 %) of the nearest's distance
-farther; branches at exactly the nearest's distance (in practice the same run: the
-sequential law in the order it would choose anyway) are taken as its outcome.
+with the branch to its own end.  The choice is *decided* when the run had not left the
+reference before t_u and the next nearest branch of another distance is FOLLOW_FACTOR
+(3) times the nearest's distance or farther (the factor of `harness branches
+--engine`, harness.branches.engines); branches at exactly the nearest's distance (in
+practice the same run: the sequential law in the order it would choose anyway) are
+taken as its outcome.  A run that left the reference before t_u gets no branch.
 """
 
 from __future__ import annotations
@@ -51,8 +53,8 @@ from reference.trajectory import Trajectory
 from ..metrics import common_window, energy_guard, impact_windows, match_impacts, match_tolerance
 from .spread import NEXT_IMPACTS, Branch, Spread
 
-# the nearest branch is decided when the runner-up is this much farther (relative)
-DECIDED_MARGIN = 0.01
+# the nearest branch is decided when the runner-up is this many times farther
+FOLLOW_FACTOR = 3.0
 
 
 @dataclass(frozen=True)
@@ -112,10 +114,13 @@ class BranchFollow:
 
     @property
     def decided(self) -> bool:
-        """The runner-up is more than DECIDED_MARGIN × the nearest's distance farther
-        (branches at exactly the nearest's distance are taken as its outcome)."""
-        m = self.margin
-        return m is not None and m > DECIDED_MARGIN * self.nearest.distance
+        """The run stayed on the reference to t_u and the runner-up is FOLLOW_FACTOR
+        times the nearest's distance or farther (branches at exactly the nearest's
+        distance are taken as its outcome)."""
+        r = self.runner_up
+        if not self.followed_reference or r is None:
+            return False
+        return r.distance >= FOLLOW_FACTOR * self.nearest.distance
 
     def to_dict(self) -> dict[str, Any]:
         doc = self.nearest.to_dict()

@@ -2,7 +2,8 @@
 
 The reference runs the scene under the paper's rule; where it stops
 `simultaneous_impact` (at t_u, contacts C touching) each branch runs the same scene
-under another impact law: `moreau`, `sequential` (the fastest approach first) and, when
+under another impact law: `moreau`, `sequential` (the fastest approach first),
+`compliant`, `compliant-mass` and, when
 at most three contacts touch, `sequential` in every order of C.  Up to t_u every branch
 is the same exact run (the same compiled loop); after it they differ only by the law.
 The contacts of the impact are those touching at t_u and those the laws gave impulses
@@ -171,7 +172,12 @@ def branches_from(scene, t_end: float, paper_traj: Trajectory, progress=None) ->
     if undecidable is None:
         return Spread(scene.name, t_end, None, paper, [])
     out = []
-    for name, law in (("moreau", "moreau"), ("sequential", "sequential")):
+    for name, law in (
+        ("moreau", "moreau"),
+        ("sequential", "sequential"),
+        ("compliant", "compliant"),
+        ("compliant-mass", "compliant-mass"),
+    ):
         if progress:
             progress(f"branches: {name}")
         out.append(run_branch(scene, t_end, name, law, None, t_u))

@@ -39,3 +39,37 @@ def format_spread(spread, label=str) -> str:
     )
     lines += textwrap.wrap(legend, WIDTH)
     return "\n".join(lines)
+
+
+def format_study(study) -> str:
+    """The engines at the undecidable impact (harness.branches.engines): one row per
+    engine and dt, its distance to each outcome and the verdict."""
+    if study.t_u is None:
+        return f"{study.scene}: {study.message}"
+    lines = [
+        f"{study.scene}: first undecidable state at t_u = {study.t_u:.17g}, contacts "
+        f"{study.contacts}; engines start {study.lead:.3g} before it, measured "
+        f"{study.after:.3g} after it",
+        "outcomes: "
+        + "; ".join(f"({i + 1}) {o.name}" for i, o in enumerate(study.outcomes))
+        + f" (the nearest two {num(study.apart, '.3g')} apart)",
+    ]
+    labels = sorted(((o.name, f"({i + 1})") for i, o in enumerate(study.outcomes)),
+                    key=lambda kv: -len(kv[0]))  # fmt: skip
+    rows = []
+    for r in study.runs:
+        dist = [num(r.distances.get(o.name), ".3g") for o in study.outcomes]
+        text = r.verdict
+        for name, label in labels:
+            text = text.replace(name, label)
+        rows.append([r.engine, num(r.dt, "g"), *dist, text])
+    header = ["engine", "dt", *(f"({i + 1})" for i in range(len(study.outcomes))), "verdict"]
+    lines.append(table(rows, header, align="lr" + "r" * len(study.outcomes) + "l"))
+    legend = (
+        "(i): distance to outcome i after the impact: the norm of the velocity, angular "
+        "velocity and contact normal velocity differences in units of max(sqrt(g a), "
+        "a/t_end); follows L: L 3 times nearer than any other and its distance falling "
+        "as dt falls (docs/laws.md)"
+    )
+    lines += textwrap.wrap(legend, WIDTH)
+    return "\n".join(lines)

@@ -3,27 +3,30 @@
 One module per command: `register` adds its parser, `run` executes it.
 
 Exit status: 0 done (also when the physics ends undecidable, or the simulator failed:
-the status says so), 2 bad input (one line on stderr: a scene, an argument or an output
-path), 1 internal failure (a traceback), 130 stopped by Ctrl-C.  With --json exactly one
-JSON document goes to stdout; progress and logs go to stderr.  Quiet by default:
-results on stdout, warnings on stderr; -v/--verbose (before or after the command) adds
-progress and diagnostics on stderr.  docs/inputs.md lists the
-accepted ranges.
+the status says so), 2 bad input or an output that cannot be written (one line on
+stderr: a scene, an argument, an output path, a full or closed stdout, memory exhausted),
+1 internal failure (a traceback), 130 stopped by Ctrl-C (SIGINT), 143 terminated
+(SIGTERM); a command that received a signal never exits 0 (harness.signals).  With
+--json exactly one JSON document goes to stdout; progress and logs go to stderr.  Quiet
+by default: results on stdout, warnings on stderr; -v/--verbose (before or after the
+command) adds progress and diagnostics on stderr.  docs/inputs.md lists the accepted
+ranges.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
-import signal
+import errno
+import os
 import sys
-import threading
 import traceback
 
 from reference.scene import SceneError
 
+from .. import signals
 from ..outputs import OutputError
 from ..provenance import PACKAGE, PROGRAM, distribution_version
+from ..signals import Terminated
 from ..text import terminal_safe
 from . import (
     analyze,
@@ -129,31 +132,63 @@ def _subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser
     return found
 
 
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised like Ctrl-C so that every cleanup runs (temporary files removed,
-    pools shut down); the command exits 143."""
+SIGNAL_LINES = {
+    signals.EXIT_INTERRUPTED: "harness: interrupted",
+    signals.EXIT_TERMINATED: "harness: terminated",
+}
 
 
-def _terminate(signum, frame) -> None:
-    raise Terminated
+class StdoutError(OSError):
+    """Writing the results to stdout failed (a full device, a closed pipe)."""
 
 
-@contextlib.contextmanager
-def _sigterm_as_interrupt():
-    """SIGTERM raises Terminated while the command runs (main thread only)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _terminate)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+class GuardedStdout:
+    """sys.stdout while a command runs: an OSError of a write or flush becomes a
+    StdoutError (exit status 2 with one line), distinct from the files a command writes."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._open().write(text)
+        except OSError as exc:
+            raise StdoutError(exc.errno, exc.strerror or str(exc)) from None
+
+    def flush(self) -> None:
+        try:
+            self._open().flush()
+        except OSError as exc:
+            raise StdoutError(exc.errno, exc.strerror or str(exc)) from None
+
+    def _open(self):
+        if self._stream is None:  # started with stdout closed: Python sets it to None
+            raise StdoutError(errno.EBADF, "stdout is closed")
+        return self._stream
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
 
 
 def main(argv: list[str] | None = None) -> int:
-    with _sigterm_as_interrupt():
-        return _main(argv)
+    stream = sys.stdout
+    sys.stdout = GuardedStdout(stream)
+    try:
+        with signals.handled():
+            return _signal_status(_main(argv))
+    finally:
+        sys.stdout = stream
+
+
+def _signal_status(code: int) -> int:
+    """The command's exit status, or its signal's when it received one: a SIGTERM or
+    Ctrl-C swallowed on its way up (a finaliser's "Exception ignored") still ends the
+    command with 143 or 130, never 0."""
+    status = signals.exit_status()
+    if status is None or code == status:
+        return code
+    print(SIGNAL_LINES[status], file=sys.stderr)
+    return status
 
 
 def _main(argv: list[str] | None) -> int:
@@ -162,24 +197,45 @@ def _main(argv: list[str] | None) -> int:
         args = build_parser(argv).parse_args(argv)
         args.argv = argv  # the exact command, for the results' provenance
         configure_logging(args.verbose)
-        return args.func(args)
+        code = args.func(args)
+        sys.stdout.flush()  # a full device shows here, not at exit
+        return code
+    except StdoutError as exc:
+        _silence_stdout()
+        print(f"harness: error: cannot write to stdout: {exc.strerror}", file=sys.stderr)
+        return 2
     except (BadInput, SceneError, OutputError) as exc:
         print(f"harness: error: {one_line(str(exc))}", file=sys.stderr)
+        return 2
+    except MemoryError as exc:  # pyarrow's ArrowMemoryError too
+        detail = f": {one_line(str(exc))}" if str(exc) else ""
+        print(f"harness: error: out of memory{detail}; nothing written", file=sys.stderr)
         return 2
     except SystemExit as exc:  # --help, --version: argparse exits
         return exc.code if isinstance(exc.code, int) else 0
     except Terminated:
-        print("harness: terminated", file=sys.stderr)
-        return 143
+        print(SIGNAL_LINES[signals.EXIT_TERMINATED], file=sys.stderr)
+        return signals.EXIT_TERMINATED
     except KeyboardInterrupt:
-        print("harness: interrupted", file=sys.stderr)
-        return 130
-    except BrokenPipeError:
-        return 0
+        status = signals.exit_status() or signals.EXIT_INTERRUPTED
+        print(SIGNAL_LINES[status], file=sys.stderr)
+        return status
     except Exception:
         traceback.print_exc()
         print("harness: internal failure (traceback above)", file=sys.stderr)
         return 1
+
+
+def _silence_stdout() -> None:
+    """After stdout failed: point its descriptor at /dev/null, so that the interpreter's
+    own flush at exit has nothing to complain about."""
+    try:
+        fd = sys.__stdout__.fileno()
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, fd)
+        os.close(null)
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 def one_line(text: str) -> str:

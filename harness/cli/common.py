@@ -235,7 +235,9 @@ def add_impact_law(p: argparse.ArgumentParser) -> None:
         metavar="NAME",
         help="impact law of simultaneous impacts in the reference: paper (the run ends "
         "simultaneous_impact), moreau (Moreau's frictionless law over every touching "
-        "contact) or sequential (single impacts, the fastest approach first) "
+        "contact), sequential (single impacts, the fastest approach first) or "
+        "compliant (the rigid limit of a spring and dashpot at every touching contact, one "
+        "stiffness everywhere; compliant-mass: stiffness in each contact's effective mass) "
         "(default: the scene's impact_law, else paper)",
     )
     p.add_argument(
@@ -243,7 +245,9 @@ def add_impact_law(p: argparse.ArgumentParser) -> None:
         type=float_in(0.0, 1e50, what="a time window [s]"),
         metavar="T",
         help="contacts reaching the ground within T of each other are one simultaneous "
-        "impact under every law (default: the scene's, else 0: strictly sequential)",
+        "impact under every law; at most the motion's time unit sqrt(a/g) (t_end without "
+        "gravity), the time of a contact's own bounce, beyond which later bounces merge "
+        "(default: the scene's, else 0: strictly sequential)",
     )
 
 

@@ -32,8 +32,8 @@ def register(sub) -> None:
         help="one run of one simulator",
         description="One run of one simulator on one scene.  Prints the run's summary "
         "(status, impacts, energy, final state).  Exit status 0 done (whatever the "
-        "physics), 2 bad input, 130 stopped by Ctrl-C (the summary of the part computed "
-        "is printed, no file is written).",
+        "physics), 2 bad input, 130 stopped by Ctrl-C, 143 by SIGTERM (the summary of the "
+        "part computed is printed, no file is written).",
     )
     add_scene(s)
     add_engine(s)
@@ -83,10 +83,11 @@ def check_outputs(args, paths) -> None:
 
 
 def run(args) -> int:
-    from ..simulators import check_engine, check_run, run_simulator
+    from ..simulators import check_engine, check_law_options, check_run, run_simulator
     from ..text import format_simulate
 
     check_engine(args.engine)
+    check_law_options(args.engine, args.impact_law, args.simultaneity_window)
     scene = load_scene_arg(args)
     check_run(args.engine, scene, args.dt, args.t_end, args.max_steps)
     check_outputs(args, planned_outputs(args))
@@ -106,7 +107,7 @@ def run(args) -> int:
     if interrupted:
         note("harness: interrupted; the summary covers the part computed, no file written")
     else:
-        write_outputs(args, traj, scene)
+        write_or_say(args, traj, scene)
     text = format_simulate(traj, scale=args.scale, wide=args.wide, label=scene.contacts.label)
     emit(summary_with_kinds(traj, scene), args.json, text)
     return INTERRUPTED if interrupted else 0
@@ -123,6 +124,21 @@ def summary_with_kinds(traj, scene) -> dict:
         for row in doc["impacts"]:
             row["kind"] = names[row["contact"]]
     return doc
+
+
+def write_or_say(args, traj, scene) -> None:
+    """`write_outputs`; memory exhausted while writing is OutputError (exit 2, one line)
+    that keeps the run's own status and message, with nothing written (the writers are
+    atomic: harness.outputs)."""
+    from ..outputs import OutputError
+
+    try:
+        write_outputs(args, traj, scene)
+    except MemoryError as exc:  # pyarrow's ArrowMemoryError too
+        raise OutputError(
+            f"out of memory while writing the outputs ({type(exc).__name__}); nothing "
+            f"written; the run itself ended {traj.status.value}: {traj.message}"
+        ) from None
 
 
 def write_outputs(args, traj, scene) -> None:

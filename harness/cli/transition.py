@@ -36,7 +36,10 @@ def register(sub) -> None:
         "three bumps of height Delta, in the paper's units (d = 0.1 m, g = 9.81), followed "
         "to the end: energy against the time to the singularity with the regimes (rim "
         "only, mixed, bumps only), the local exponent c of each, the tilt at which the "
-        "bumps take over against Delta/a, the time in each regime.",
+        "bumps take over against Delta/a, the time in each regime.  The reference run ends "
+        "failed ('stalled at t = ...') when three returns of its loop in a row advance t by "
+        "less than one roundoff unit of the motion's time scale sqrt(a/g) per step (the "
+        "bumpy ground's contact phases can creep, e.g. at restitution 0).",
     )
     t.add_argument(
         "scene",
@@ -103,6 +106,8 @@ def run(args) -> int:
         check_writable(args.plot, args.force, inputs, what="--plot", suffixes=(".png",))
 
     def simulate(engine, scene, dt, t_end, progress=None):
+        if engine == "reference":
+            return bounded_reference(scene, t_end)
         return run_simulator(engine, scene, dt, t_end, max_steps=args.max_steps, progress=progress)
 
     _, doc = run_transition(scene, args.engine, args.dt, args.t_end, simulate, progress=None)
@@ -116,3 +121,20 @@ def run(args) -> int:
     log(f"transition: {len(doc['regimes'])} regimes")
     emit(attach(doc, args), args.json, format_transition(doc))
     return 0
+
+
+def bounded_reference(scene, t_end):
+    """The reference run under a StallGuard (harness.stall): a run that stops advancing
+    (the bumpy ground's contact phases can creep once the disk lies nearly flat on a
+    bump) ends `failed` with the guard's sentence instead of running for ever."""
+    from reference import simulate
+    from reference.trajectory import Trajectory
+
+    from ..guard import guard_trajectory
+    from ..stall import Stalled, StallGuard
+
+    try:
+        traj = simulate(scene, t_end=t_end, progress=StallGuard(scene))
+    except Stalled as exc:
+        traj = Trajectory.failed("reference", scene.name, None, str(exc))
+    return guard_trajectory(scene, traj)

@@ -5,8 +5,9 @@ engines) or once (`reference`, `linear`: event-driven, dt does not apply).  Each
 scored by `harness.metrics.evaluate`, and gets an energy exponent c only if it reached
 the end of the motion (`harness.metrics.run_exponent`).  An engine that raises is
 recorded as a run with status `failed` and the exception as its message, so one broken
-engine does not hide the others' results; bad input (`SceneError`) still stops the
-command.
+engine (a plug-in raising SceneError for a scene it does not take included) does not
+hide the others' results; bad input is refused before any run (harness.simulators.
+check_run).
 
 When the reference ends `simultaneous_impact` (the paper's rule at an undecidable state,
 t_u), the scene is continued from there under every impact law (harness.branches.spread)
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from reference.exponent import ExponentFit
-from reference.scene import Scene, SceneError
+from reference.scene import Scene
 from reference.scenes import as_scene
 from reference.trajectory import Status, Trajectory
 
@@ -249,8 +250,6 @@ def _timed_run(
         traj = run_simulator(engine, scene, dt=dt, t_end=t_end, max_steps=max_steps)
         if traj.stats.get("interrupted"):
             raise KeyboardInterrupt
-    except SceneError:
-        raise
     except Exception as exc:  # an engine that breaks is a result, not a crash
         if reraise:
             raise

@@ -8,13 +8,14 @@ from __future__ import annotations
 import textwrap
 from typing import TYPE_CHECKING
 
-from ..branches.follow import DECIDED_MARGIN, BranchFollow
+from ..branches.follow import FOLLOW_FACTOR, BranchFollow
 from ..text import num, table
 
 if TYPE_CHECKING:
     from . import CompareResult, EngineRun
 
 WIDTH = 100
+LEFT = "left the reference before t_u: no branch"
 
 
 def impacts_text(c) -> str:
@@ -35,11 +36,13 @@ def branch_sentence(run: EngineRun) -> str | None:
     b = run.branch
     if b is None:
         return None
+    if not b.followed_reference:
+        return f"{run.label} {LEFT}."
     n, r = b.nearest, b.runner_up
     if r is None and len(b.candidates) > 1:
         head = f"{run.label} is as near to every branch (distance {n.distance:.3g}: undecided"
     elif r is None or b.decided:
-        head = f"{run.label} follows {n.branch} (distance {n.distance:.3g}"
+        head = f"{run.label} is nearest to {n.branch} (distance {n.distance:.3g}"
         head += "" if r is None else f"; next {r.branch} {r.distance:.3g}"
     else:
         head = (f"{run.label} is as near to {n.branch} as to {r.branch} (distance "
@@ -49,8 +52,6 @@ def branch_sentence(run: EngineRun) -> str | None:
         f"{head}): it reproduces {impacts_text(n)} of {n.branch}'s impacts after t_u, "
         f"until t = {until}"
     )
-    if not b.followed_reference:
-        text += "; it had left the reference before t_u"
     return text + "."
 
 
@@ -64,30 +65,32 @@ def branch_lines(result: CompareResult) -> list[str]:
     contacts = ", ".join(result.scene.contacts.label(int(k)) for k in u["contacts"])
     head = (
         f"After the undecidable state at t_u = {u['t']:.7g} s ({contacts}) the reference "
-        f"goes on under each law (harness branches {result.scene.name}): the branch each "
-        "run follows, nearest by its next impacts and its energy:"
+        f"goes on under each law (harness branches {result.scene.name}): the branch that each "
+        "run stays on, nearest by its next impacts and its energy:"
     )
-    rows = []
+    rows, left = [], []
     for run in result.runs:
         b = run.branch
         if b is None:
+            continue
+        if not b.followed_reference:
+            left.append(f"{run.label}: {LEFT}")
             continue
         n = b.nearest
         rows.append([run.label, n.branch, num(n.distance, ".3g"), runner_up_text(b),
                      impacts_text(n), num(n.until, ".7g"),
                      "yes" if b.followed_reference else "no"])  # fmt: skip
-    if not rows:
+    if not rows and not left:
         return []
     header = ["simulator", "branch", "d", "next nearest", "impacts", "until [s]", "on ref"]
     legend = (
         "d: distance to the branch (docs/output.md): the first "
         "impacts after t_u in windows plus the energy difference over E(t_u); ≈: no branch "
-        f"{DECIDED_MARGIN:.0%} nearer than the next. impacts: k+s/N of the branch's impacts "
-        "after t_u reproduced in order (s chatter tails skipped), until the first "
-        "disagreement. on ref: the run had not diverged from the reference before t_u."
+        f"{FOLLOW_FACTOR:g} times nearer than the next (which law an engine follows: "
+        "harness branches SCENE --engine E --dt ..., docs/laws.md). impacts: k+s/N of "
+        "the branch's impacts after t_u reproduced in order (s chatter tails skipped), "
+        "until the first disagreement. on ref: the run had not diverged from the "
+        "reference before t_u."
     )
-    return [
-        *textwrap.wrap(head, WIDTH),
-        table(rows, header, align="llrlrrl"),
-        *textwrap.wrap(legend, WIDTH),
-    ]
+    shown = [table(rows, header, align="llrlrrl")] if rows else []
+    return [*textwrap.wrap(head, WIDTH), *shown, *left, *textwrap.wrap(legend, WIDTH)]

@@ -101,12 +101,7 @@ def load_inputs(path: str | Path) -> list[ReportInput]:
     problem = input_file_problem(p)
     if problem:
         raise ReportInputError(f"{show(p)}: {problem}")
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8-sig"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ReportInputError(f"{show(p)}: not a JSON document ({exc})") from None
-    except OSError as exc:
-        raise ReportInputError(f"{show(p)}: cannot be read ({exc.strerror})") from None
+    doc = _json_document(p)
     kind = detect_kind(doc)
     if kind is None:
         raise ReportInputError(
@@ -118,6 +113,21 @@ def load_inputs(path: str | Path) -> list[ReportInput]:
     except SchemaError as exc:
         raise ReportInputError(f"{show(p)}: not a valid {kind} document: {exc}") from None
     return [ReportInput(p, kind, doc)]
+
+
+def _json_document(p: Path) -> Any:
+    """The JSON document in file `p`, or ReportInputError with the reason: not JSON (a
+    decoding error, an integer beyond Python's 4300 digits), nested too deeply for the
+    parser (RecursionError), unreadable."""
+    try:
+        return json.loads(p.read_text(encoding="utf-8-sig"))
+    except RecursionError:
+        raise ReportInputError(f"{show(p)}: JSON nested too deeply to be a result") from None
+    except ValueError as exc:  # JSONDecodeError, UnicodeDecodeError, a huge integer
+        reason = " ".join(str(exc).split())[:200]
+        raise ReportInputError(f"{show(p)}: not a JSON document ({reason})") from None
+    except OSError as exc:
+        raise ReportInputError(f"{show(p)}: cannot be read ({exc.strerror})") from None
 
 
 def _sweep_directory(p: Path) -> list[ReportInput]:

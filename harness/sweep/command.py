@@ -9,7 +9,7 @@ from pathlib import Path
 
 from reference.scene import SceneError
 
-from ..simulators import check_engine, check_run, is_fixed_step
+from ..simulators import check_engine, check_law_options, check_run, is_fixed_step
 from .executors import ExecutorError, check_scheduler
 from .grid import (
     SweepConfig,
@@ -57,8 +57,9 @@ def config_from_args(args) -> SweepConfig:
         simultaneity_window=sweep_window(args),
         **extra,
     )
-    if getattr(args, "simultaneity_window", None) is not None and not takes_window(args.engine):
-        raise _bad("--simultaneity-window applies to the reference and linear engines only")
+    check_law_options(
+        args.engine, getattr(args, "impact_law", None), getattr(args, "simultaneity_window", None)
+    )
     check_config(config)
     return config
 
@@ -76,11 +77,6 @@ def sweep_window(args) -> float:
     if args.engine == "reference":
         return default_window(getattr(args, "impact_law", None) or "paper")
     return LINEAR_DEFAULT_WINDOW if args.engine == "linear" else 0.0
-
-
-def takes_window(engine: str) -> bool:
-    """The event-driven simulators resolve simultaneous impacts under a window."""
-    return engine in ("reference", "linear")
 
 
 def check_config(config: SweepConfig) -> None:

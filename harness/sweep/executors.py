@@ -16,6 +16,7 @@ flight), so that the chunks that merely shared the broken pool are not blamed tw
 from __future__ import annotations
 
 import os
+import signal
 import threading
 import time
 from collections import deque
@@ -32,8 +33,12 @@ class ExecutorError(Exception):
 
 
 def _exit_with_parent(parent_pid: int) -> None:
-    """Worker initializer: exit when the parent dies (e.g. SIGKILL), so no orphan keeps
-    computing after the sweep is gone."""
+    """Worker initializer: the signals left to the parent (Ctrl-C reaches the whole
+    process group: the parent stops the pool; SIGTERM ends a worker at once, without the
+    parent's handler inherited by fork), and exit when the parent dies (e.g. SIGKILL),
+    so no orphan keeps computing after the sweep is gone."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
     def watch() -> None:
         while True:
@@ -42,6 +47,48 @@ def _exit_with_parent(parent_pid: int) -> None:
             time.sleep(0.5)
 
     threading.Thread(target=watch, daemon=True, name="exit-with-parent").start()
+
+
+# Seconds between checks that the local pool still runs while no chunk finishes.
+POOL_CHECK_S = 1.0
+
+
+def _pool_running(pool) -> bool:
+    """Whether the pool's manager thread (which feeds the workers and collects their
+    results) runs: when it could not start its own threads (memory or thread limits)
+    it dies, and no future would ever finish."""
+    thread = getattr(pool, "_executor_manager_thread", None)
+    return thread is None or thread.is_alive()
+
+
+_thread_failures: list[BaseException] = []
+
+
+def _note_thread_failure(args) -> None:
+    """threading.excepthook while a local pool runs: a pool thread that dies (it could
+    not start its own threads) is reported in the one-line error, not as a traceback."""
+    if args.exc_value is not None:
+        _thread_failures.append(args.exc_value)
+
+
+def _stop(pool) -> None:
+    """Shut the pool down without waiting; a pool whose manager thread died cannot stop
+    its workers itself (they wait for work for ever, and the interpreter would wait for
+    them at exit), so they are terminated."""
+    running = _pool_running(pool)
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    if not running:
+        for process in processes:
+            process.terminate()
+
+
+def _cannot_run(exc: BaseException | None = None) -> ExecutorError:
+    detail = f" ({type(exc).__name__}: {exc})" if exc is not None else ""
+    return ExecutorError(
+        f"the local worker pool cannot run{detail}: out of memory or threads (ulimit -v, "
+        "ulimit -u)? try fewer --workers"
+    )
 
 
 class _Work:
@@ -90,6 +137,8 @@ def run_local(
     limit = 2 * workers + 1
     pool = new_pool()
     inflight: dict = {}
+    previous_hook = threading.excepthook
+    threading.excepthook = _note_thread_failure
     try:
         while queue or inflight:
             while queue and len(inflight) < limit:
@@ -105,7 +154,11 @@ def run_local(
                     queue.appendleft(w)
                     pool.shutdown(wait=False, cancel_futures=True)
                     pool = new_pool()
-            done, _ = wait(list(inflight), return_when=FIRST_COMPLETED)
+                except (RuntimeError, MemoryError) as exc:  # "can't start new thread"
+                    raise _cannot_run(exc) from None
+            done, _ = wait(list(inflight), timeout=POOL_CHECK_S, return_when=FIRST_COMPLETED)
+            if not done and not _pool_running(pool):
+                raise _cannot_run(_thread_failures[-1] if _thread_failures else None)
             for fut in done:
                 w, p = inflight.pop(fut)
                 try:
@@ -119,7 +172,8 @@ def run_local(
                         continue
                 yield w.chunk, rows
     finally:
-        pool.shutdown(wait=False, cancel_futures=True)
+        threading.excepthook = previous_hook
+        _stop(pool)
 
 
 def check_scheduler(scheduler: str, timeout_s: float = 5.0) -> None:

@@ -132,7 +132,7 @@ def _read_json(path: Path):
         d = json.loads(path.read_text(encoding="utf-8"))
         SweepConfig.from_dict(d)
         return d
-    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError):
         return _UNREADABLE
 
 

@@ -36,6 +36,12 @@ Laws (`LAW_*`; their names in `LAW_NAMES`):
   sweeps over a given order (each contact of the order that approaches is hit, in
   turn: the orders of `harness branches`).  At most MAX_SEQUENTIAL_IMPACTS single
   impacts; beyond, status NOT_SETTLED.
+- `compliant` (reference.core.compliant.compliant_impulses): the rigid limit of a
+  linear spring and dashpot at every touching contact, the same stiffness everywhere
+  and each dashpot set so that its contact alone obeys eq. F; solved exactly per set
+  of pushing contacts.  It needs `vec` of reference.core.compliant.work_size(k).
+- `compliant-mass` (compliant_mass_impulses): the same with each contact's stiffness in
+  its effective mass, kᵢ ∝ 1/Wᵢᵢ.
 
 No energetic law (Darboux–Keller, Stronge, LZB): see docs/laws.md, "The
 laws" (not exact in closed form: an ODE in the impulse with switching, and LZB needs
@@ -47,6 +53,8 @@ import math
 from .impact import post_impact_velocity
 from .jit import hot
 from .law_codes import (  # noqa: F401  (the codes and limits, re-exported)
+    LAW_COMPLIANT,
+    LAW_COMPLIANT_MASS,
     LAW_MOREAU,
     LAW_NAMES,
     LAW_PAPER,

@@ -4,7 +4,9 @@ uses them in compiled code; Python callers read them from here without importing
 LAW_PAPER = 0
 LAW_MOREAU = 1
 LAW_SEQUENTIAL = 2
-LAW_NAMES = ("paper", "moreau", "sequential")
+LAW_COMPLIANT = 3
+LAW_COMPLIANT_MASS = 4
+LAW_NAMES = ("paper", "moreau", "sequential", "compliant", "compliant-mass")
 
 # Outcomes of a law's solve
 SETTLED = 0

@@ -4,8 +4,11 @@ impulses (reference.core.impact_laws), and (v, ω) += M⁻¹JᵀΛ.  Positions a
 (paper §2.3: impacts are instantaneous)."""
 
 from .chatter import completion_speed
+from .compliant import compliant_impulses, compliant_mass_impulses
 from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
 from .impact_laws import (
+    LAW_COMPLIANT,
+    LAW_COMPLIANT_MASS,
     LAW_MOREAU,
     LAW_SEQUENTIAL,
     NOT_SETTLED,
@@ -45,8 +48,8 @@ def law_impact(
     y, model, pts, law, contacts, k, order, n_order, max_hits, chatter_tol,
     W, u_pre, lam, u_post, chol, vec, active, result,
 ):  # fmt: skip
-    """In place: the impact of contacts[:k] on state y under `law` (LAW_MOREAU or
-    LAW_SEQUENTIAL; order[:n_order] the sequential law's order, empty: the fastest
+    """In place: the impact of contacts[:k] on state y under `law` (LAW_MOREAU,
+    LAW_SEQUENTIAL or LAW_COMPLIANT; order[:n_order] the sequential law's order, empty: the fastest
     first), restitution model.gamma.  Fills u_pre, lam, u_post (per contact) and
     result[:3] = (status, number of single impacts: 1 for Moreau, 1 if the bounces were
     completed); y changes only when the law settled.
@@ -95,6 +98,12 @@ def _solve_law(
         status, hits = sequential_impulses(
             W, u_pre, gamma, k, order, n_order, lam, u_post, max_hits
         )
+    elif law == LAW_COMPLIANT:
+        status = compliant_impulses(W, u_pre, gamma, k, lam, u_post, vec, active)
+        hits = 1
+    elif law == LAW_COMPLIANT_MASS:
+        status = compliant_mass_impulses(W, u_pre, gamma, k, lam, u_post, vec, active)
+        hits = 1
     else:
         status, hits = NOT_SETTLED, 0
     result[0], result[1] = status, hits

@@ -41,7 +41,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..continuation import MAX_RESTARTS_AT_ONE_TIME
+from ..core.compliant import compliant_impulses, compliant_mass_impulses, work_size
 from ..core.impact_laws import (
+    LAW_COMPLIANT,
+    LAW_COMPLIANT_MASS,
     LAW_MOREAU,
     LAW_NAMES,
     LAW_SEQUENTIAL,
@@ -68,7 +71,7 @@ LEAVING_ULPS = 64.0
 
 
 def law_impulses(W, u_pre, gamma, law: int):
-    """(status, Λ, u⁺, single impacts) of `law` (LAW_MOREAU or LAW_SEQUENTIAL, the
+    """(status, Λ, u⁺, single impacts) of `law` (LAW_MOREAU, LAW_COMPLIANT or LAW_SEQUENTIAL, the
     fastest approach first) on k contacts of Delassus matrix W and normal velocities
     u⁻: the exact core's law functions (reference.core.impact_laws), called as they are."""
     k = len(u_pre)
@@ -86,6 +89,11 @@ def law_impulses(W, u_pre, gamma, law: int):
             W, u_pre, float(gamma), k, order, 0, lam, u_post, MAX_SEQUENTIAL_IMPACTS
         )
         return int(status), lam, u_post, int(hits)
+    if law in (LAW_COMPLIANT, LAW_COMPLIANT_MASS):
+        solve = compliant_impulses if law == LAW_COMPLIANT else compliant_mass_impulses
+        work, active = np.zeros(work_size(k)), np.zeros(k, dtype=np.int64)
+        status = solve(W, u_pre, float(gamma), k, lam, u_post, work, active)
+        return int(status), lam, u_post, 1
     raise ValueError(f"no law function for {LAW_NAMES[law]!r}")
 
 
@@ -377,8 +385,8 @@ def run_under_law(
     from .simulate import LinearRun, run_message, run_segment
 
     law_id = LAW_NAMES.index(law)
-    if law_id not in (LAW_MOREAU, LAW_SEQUENTIAL):
-        raise ValueError(f"impact law must be moreau or sequential here, got {law!r}")
+    if law_id not in (LAW_MOREAU, LAW_SEQUENTIAL, LAW_COMPLIANT, LAW_COMPLIANT_MASS):
+        raise ValueError(f"impact law must be one that resolves the impact here, got {law!r}")
     F, theta, gamma = model.F, model.theta, model.restitution
     q, p = np.array(q0, dtype=float), np.array(p0, dtype=float)
     e_init = model.energy(q, p)

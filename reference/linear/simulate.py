@@ -144,7 +144,8 @@ def run_linear(
     for completing without the proof and for two-contact accumulations (kernel.py).
 
     `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
-    or `moreau` / `sequential`: the run goes on past it under that law (laws.py).
+    or `moreau` / `sequential` / `compliant`: the run goes on past it under that law
+    (laws.py).
     `simultaneity_window`: open contacts reaching the ground within this time of the
     first are reached together with it (0: strictly sequential)."""
     if impact_law != "paper":
