@@ -7,7 +7,8 @@ markers, `<!-- fig:NAME -->…<!-- /fig:NAME -->` (`make docs-figures`).
     sweep         README: how the runs of its `sweep exponent` example end, the mapped c
     startup       README and docs/performance.md: `harness simulate pentagon-bounce
                   --json` against `python -c "import numpy"`, median of the ratios of
-                  alternating pairs of whole processes
+                  alternating pairs of whole processes (the package byte-compiled first,
+                  as an installed one is)
     api-output    docs/api.md: what its example prints
     api-time      docs/api.md: the example's wall time
 
@@ -127,6 +128,10 @@ def startup_ratio(pairs: int) -> tuple[float, float, float]:
         subprocess.run(cmd, cwd=ROOT, capture_output=True, check=True)
         return time.perf_counter() - t
 
+    # the package's bytecode, as an installed package has it (pip compiles it; here
+    # PYTHONDONTWRITEBYTECODE may be set, and every run would compile the sources again)
+    packages = ("harness", "reference", "engines")
+    subprocess.run([sys.executable, "-m", "compileall", "-q", *packages], cwd=ROOT, check=True)
     once(cmd_a), once(cmd_b)
     a, b = [], []
     for _ in range(pairs):
