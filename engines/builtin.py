@@ -2,7 +2,9 @@
 in pyproject.toml like any third-party engine; docs/engines.md).
 
 This module imports nothing heavy: each callable imports its engine when it runs, so that
-listing the engines or running the reference never imports MuJoCo, PyBullet or Drake.
+listing the engines or running the reference never imports MuJoCo, PyBullet, Drake, DART
+or JAX.  MuJoCo and PyBullet are core dependencies; every other engine names the pip extra
+that installs its library (`extra`).
 """
 
 from __future__ import annotations
@@ -25,13 +27,26 @@ LINEAR_GROUNDS = ("flat", "three_point")
 
 
 def _profile(
-    module: str, function: str, profile: str, library: str, doc: str, progress: bool = False
+    module: str,
+    function: str,
+    profile: str,
+    library: str,
+    doc: str,
+    progress: bool = False,
+    extra: str | None = None,
+    ground_kinds: tuple[str, ...] | None = None,
 ) -> Callable:
     """An entry point that runs `module.function(scene, dt, t_end=…, profile=…)` (and
-    passes `progress` on when the adapter reports it)."""
+    passes `progress` on when the adapter reports it); `extra`: the pip extra that installs
+    `library` (None for the core engines)."""
 
     @engine_entry(
-        fixed_step=True, library=library, max_vertices=MAX_VERTICES, reports_progress=progress
+        fixed_step=True,
+        library=library,
+        max_vertices=MAX_VERTICES,
+        reports_progress=progress,
+        extra=extra,
+        ground_kinds=ground_kinds,
     )
     def simulate(
         scene: Scene, *, dt: float, t_end: float | None = None, progress=None
@@ -94,7 +109,12 @@ pybullet_default = _profile(
     progress=True,
 )
 drake = _profile(
-    "engines.drake", "simulate_drake", "sap", "drake", "Drake, discrete plant with the SAP solver"
+    "engines.drake",
+    "simulate_drake",
+    "sap",
+    "drake",
+    "Drake, discrete plant with the SAP solver",
+    extra="drake",
 )
 drake_continuous = _profile(
     "engines.drake",
@@ -102,7 +122,55 @@ drake_continuous = _profile(
     "continuous",
     "drake",
     "Drake, continuous plant, error-controlled RK3 (dt = its maximum step)",
+    extra="drake",
 )
+# DART's grounds (engines.dart.GROUND_KINDS: bumpy needs per-shape collision masks).
+DART_GROUNDS = ("flat", "three_point")
+dart = _profile(
+    "engines.dart",
+    "simulate_dart",
+    "tuned",
+    "dartpy",
+    "DART, LCP contact: restitution gamma, units scaled past its rebound cut-off",
+    progress=True,
+    extra="dart",
+    ground_kinds=DART_GROUNDS,
+)
+dart_default = _profile(
+    "engines.dart",
+    "simulate_dart",
+    "default",
+    "dartpy",
+    "DART, defaults + restitution sqrt(gamma) per shape (cut-off 0.1)",
+    progress=True,
+    extra="dart",
+    ground_kinds=DART_GROUNDS,
+)
+
+
+def _mjx(precision: str, name: str, doc: str) -> Callable:
+    """An MJX entry point (float64 or float32) that also offers `simulate_batch`."""
+
+    @engine_entry(fixed_step=True, library="mujoco-mjx", max_vertices=MAX_VERTICES, extra="mjx")
+    def simulate(scene: Scene, *, dt: float, t_end: float | None = None, progress=None):
+        from engines.mjx import simulate_mjx
+
+        return simulate_mjx(scene, dt, t_end=t_end, precision=precision, progress=progress)
+
+    def simulate_batch(scenes, *, dt: float, t_end: float | None = None):
+        from engines.mjx import simulate_mjx_batch
+
+        return simulate_mjx_batch(scenes, dt=dt, t_end=t_end, precision=precision)
+
+    simulate.reports_progress = True
+    simulate.simulate_batch = simulate_batch
+    simulate.__doc__ = doc
+    simulate.__qualname__ = simulate.__name__ = name
+    return simulate
+
+
+mjx = _mjx("float64", "mjx", "MJX (MuJoCo XLA) on JAX, float64: the mujoco model, diagexact off")
+mjx_f32 = _mjx("float32", "mjx_f32", "MJX (MuJoCo XLA) on JAX, float32: the mujoco model")
 
 # The entry points this package registers (pyproject.toml, group harness.engines), name →
 # attribute of this module: `harness.simulators` loads these names from here without
@@ -117,4 +185,8 @@ BUILTIN_ENGINES = {
     "pybullet-default": "pybullet_default",
     "drake": "drake",
     "drake-continuous": "drake_continuous",
+    "dart": "dart",
+    "dart-default": "dart_default",
+    "mjx": "mjx",
+    "mjx-f32": "mjx_f32",
 }

@@ -59,7 +59,6 @@ from __future__ import annotations
 
 import logging
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,12 +68,17 @@ from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
 from .base import (
-    build_trajectory,
     effective_contact_mass,
     initial_state,
     typical_impact_speed,
 )
-from .stepping import SPHERE_RADIUS_FRACTION, Rows, first_failure, run_steps
+from .stepping import (
+    SPHERE_RADIUS_FRACTION,
+    Recording,
+    Rows,
+    first_failure,
+    simulate_fixed_step,
+)
 
 PROFILES = ("sap", "continuous")
 ENGINE_NAMES = {"sap": "drake", "continuous": "drake-continuous"}
@@ -514,33 +518,38 @@ class _SimulatorStepper:
         self.cut(kept - self.first)
         return self.times[-1] if self.times else 0.0
 
+    def recording(self, loop) -> Recording:
+        return _recording(self, loop)
+
 
 def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None = None):
     """`simulate_drake` with explicit settings (the restitution study varies them).  One
-    chunk of the run loop (engines.stepping.run_steps) to t_end: Drake's Simulator takes
-    its own steps (error-controlled on the continuous plant), which a chunk boundary
-    would cut."""
-    t_wall = time.perf_counter()
-    t_end = scene.run.t_end if t_end is None else float(t_end)
-    model = build_model(scene, settings)
+    chunk of the driver (engines.stepping.simulate_fixed_step) to t_end: Drake's
+    Simulator takes its own steps (error-controlled on the continuous plant), which a
+    chunk boundary would cut."""
     dt = settings.time_step or settings.max_step
-    n_steps = max(1, int(round(t_end / dt)))
-    stepper = _SimulatorStepper(scene, model, t_end, dt)
-    loop = run_steps(stepper, scene, n_steps, n_steps, t_end=t_end)
-    status, message = loop.status, loop.message
+
+    def build(n_steps: int) -> _SimulatorStepper:
+        t_run = scene.run.t_end if t_end is None else float(t_end)
+        stepper = _SimulatorStepper(scene, build_model(scene, settings), t_run, dt)
+        stepper.scene, stepper.settings = scene, settings
+        return stepper
+
+    return simulate_fixed_step(scene, ENGINE_NAMES[settings.profile], dt, t_end, build)
+
+
+def _recording(stepper: _SimulatorStepper, loop) -> Recording:
+    """Every monitored row (the finite ones after a failure), its impulses and the
+    profile's parameters."""
+    scene, settings = stepper.scene, stepper.settings
     n_contacts = scene.n_contacts
     t = np.array(stepper.times)
     states = from_drake_state(np.array(stepper.rows)) if stepper.rows else np.zeros((0, 13))
     F = np.array(stepper.forces) if stepper.forces else np.zeros((0, n_contacts))
-    if status is Status.FAILED:  # keep the finite rows only
+    if loop.status is Status.FAILED:  # keep the finite rows only
         ok = np.all(np.isfinite(states), axis=1)
         t, states, F = t[ok], states[ok], F[ok]
-    impulses = _impulses(t, F, settings)
-    steps = max(len(t) - 1, 0)
     stats = {
-        "wall_time_s": time.perf_counter() - t_wall,
-        "steps": steps,
-        "steps_per_s": steps / loop.stepping_s if loop.stepping_s > 0 else None,
         "profile": settings.profile,
         "stiffness": settings.stiffness,
         "hc_dissipation": settings.hc_dissipation,
@@ -552,11 +561,7 @@ def run_with_settings(scene: Scene, settings: DrakeSettings, t_end: float | None
         "quaternion_norm_drift": quaternion_norm_drift(np.array(stepper.rows)),
         "drake_version": _drake_version(),
     }
-    if loop.interrupted:
-        stats["interrupted"] = True
-    return build_trajectory(
-        scene, ENGINE_NAMES[settings.profile], dt, t, states, impulses, status, message, stats
-    )
+    return Recording(t, states, _impulses(t, F, settings), max(len(t) - 1, 0), stats)
 
 
 def _impulses(t: np.ndarray, F: np.ndarray, settings: DrakeSettings) -> np.ndarray:

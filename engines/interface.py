@@ -1,11 +1,13 @@
 """The engine interface, typed: what an entry point of the group `harness.engines` is
 (docs/engines.md "Plugging in an engine").
 
-An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with five optional
-attributes; `engine_entry` sets them on a function, and `attribute` reads one with its
-default (harness.simulators reads them only through it).  A fixed-step adapter usually
-wraps its engine in an `engines.stepping.Stepper` and lets `engines.stepping.run_steps`
-drive it (progress, fall-through checks, Ctrl-C); `examples/toy-engine` does both.
+An engine is a callable `simulate(scene, *, dt, t_end) -> Trajectory` with seven optional
+attributes; `engine_entry` sets the first six on a function (`simulate_batch` is set by
+hand), and `attribute` reads one with its default (harness.simulators reads them only
+through it).  A fixed-step adapter usually wraps its engine in an
+`engines.stepping.Adapter` and lets `engines.stepping.simulate_fixed_step` drive it (end
+time, step count, progress, fall-through checks, Ctrl-C, common stats);
+`examples/toy-engine` does both.
 """
 
 from __future__ import annotations
@@ -29,6 +31,15 @@ class Engine(Protocol):
     reports_progress  True: it accepts `progress=callback(done, total)` and calls it
     ground_kinds      the only ground kinds it takes (`flat`, `three_point`, `bumpy`;
                       others are refused before the run, exit 2), or None for every ground
+    extra             the pip extra of this package that installs `library`
+                      (`pip install 'euler-disk-harness[EXTRA]'`), or None when `library`
+                      is a core dependency (or comes from elsewhere); `harness engines`
+                      shows it for an engine whose library is missing
+    simulate_batch    optional: `simulate_batch(scenes, *, dt, t_end) -> list[Trajectory]`,
+                      many scenes at one dt in one call (t_end None: each scene's own
+                      run.t_end), each result the Trajectory the serial call gives;
+                      None when the engine offers no batch (`run_batch` in
+                      harness.simulators then loops serially)
     """
 
     fixed_step: bool
@@ -36,6 +47,7 @@ class Engine(Protocol):
     max_vertices: int | None
     reports_progress: bool
     ground_kinds: tuple[str, ...] | None
+    extra: str | None
 
     def __call__(
         self, scene: Scene, *, dt: float | None = None, t_end: float | None = None
@@ -49,6 +61,8 @@ DEFAULTS: dict[str, Any] = {
     "max_vertices": None,
     "reports_progress": False,
     "ground_kinds": None,
+    "extra": None,
+    "simulate_batch": None,
 }
 
 
@@ -63,6 +77,7 @@ def engine_entry(
     max_vertices: int | None = None,
     reports_progress: bool = False,
     ground_kinds: tuple[str, ...] | None = None,
+    extra: str | None = None,
 ) -> Callable[[Callable], Engine]:
     """Make a `simulate(scene, *, dt, t_end)` function an `Engine` with these attributes."""
 
@@ -72,6 +87,7 @@ def engine_entry(
         fn.max_vertices = max_vertices
         fn.reports_progress = reports_progress
         fn.ground_kinds = ground_kinds
+        fn.extra = extra
         return fn  # type: ignore[return-value]
 
     return mark

@@ -31,7 +31,6 @@ and the onset row.
 from __future__ import annotations
 
 import contextlib
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -47,7 +46,7 @@ from reference.trajectory import Status, Trajectory
 
 from .base import build_trajectory
 from .mujoco_model import contact_settings, load_model
-from .stepping import Rows, run_steps
+from .stepping import Recording, Rows, run_fixed_step
 
 ENGINE_NAMES = {"tuned": "mujoco", "default": "mujoco-default"}
 STATE_SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -210,25 +209,35 @@ class _RolloutStepper:
         self.rows, self.after = [np.concatenate(self.rows)[: self.done + 1]], None
         return self.done * self.dt
 
+    def recording(self, loop) -> Recording:
+        return _recording(self)
 
-def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
-    t_wall = time.perf_counter()
+
+def _build(scene: Scene, dt: float, profile: str, half_step: bool | None):
+    """The Adapter builder of `run_fixed_step`: the model, its data at the initial state
+    (at v(−h/2) under the leapfrog reading) and the rollout stepper."""
     if profile not in ENGINE_NAMES:
         raise ValueError(f"unknown MuJoCo profile {profile!r}; choose tuned or default")
-    t_end = scene.run.t_end if t_end is None else float(t_end)
-    n_steps = max(1, int(round(t_end / dt)))
     settings = contact_settings(scene, dt, profile)
-    model = load_model(scene, dt, profile)
-    data = mujoco.MjData(model)
-    y0 = initial_state(scene.initial)
     half = settings.half_step_velocities if half_step is None else half_step
-    set_state(model, data, staggered_start(scene, y0, dt) if half else y0)
-    stepper = _RolloutStepper(scene, model, data, dt)
-    stepper.n_steps = n_steps
-    loop = run_steps(stepper, scene, n_steps, CHUNK_STEPS, progress)
-    status, message = loop.status, loop.message
 
-    nq, nv = model.nq, model.nv
+    def build(n_steps: int) -> _RolloutStepper:
+        model = load_model(scene, dt, profile)
+        data = mujoco.MjData(model)
+        y0 = initial_state(scene.initial)
+        set_state(model, data, staggered_start(scene, y0, dt) if half else y0)
+        stepper = _RolloutStepper(scene, model, data, dt)
+        stepper.n_steps, stepper.settings, stepper.half, stepper.y0 = n_steps, settings, half, y0
+        return stepper
+
+    return build
+
+
+def _recording(stepper: _RolloutStepper) -> Recording:
+    """The rollout rows in the reference's conventions (whole-step velocities under the
+    leapfrog reading), the contact impulses and the profile's parameters."""
+    scene, dt, settings, half = stepper.scene, stepper.dt, stepper.settings, stepper.half
+    nq, nv = stepper.nq, stepper.nv
     rows_all = np.concatenate(stepper.rows)
     t = dt * np.arange(len(rows_all))  # = MuJoCo's time, without its accumulated roundoff
     states = _states(rows_all, nq, nv)
@@ -241,13 +250,9 @@ def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
         y_after = _states(after[None], nq, nv)[0] if after is not None else None
         states = whole_step_velocities(scene, states, y_after, impulses > 0.0, dt)
         # known exactly: MuJoCo started from v(−h/2) built from it
-        states[0, L.VELOCITIES] = y0[L.VELOCITIES]
-    steps = len(t) - 1
+        states[0, L.VELOCITIES] = stepper.y0[L.VELOCITIES]
     stats = {
-        "wall_time_s": time.perf_counter() - t_wall,
-        "steps": steps,
-        "steps_per_s": steps / loop.stepping_s if loop.stepping_s > 0 else None,
-        "profile": profile,
+        "profile": settings.profile,
         "integrator": settings.integrator or "Euler (MuJoCo default)",
         "solref": list(settings.solref) if settings.solref else "MuJoCo default",
         "solimp": list(settings.solimp) if settings.solimp else "MuJoCo default",
@@ -255,9 +260,16 @@ def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
         "restitution_model": settings.restitution_model,
         "mujoco_version": mujoco.__version__,
     }
-    if loop.interrupted:
-        stats["interrupted"] = True
-    return MujocoRun(scene, profile, dt, t, states, impulses, status, message, stats)
+    return Recording(t, states, impulses, len(t) - 1, stats)
+
+
+def _run_mujoco(scene, dt, t_end, profile, half_step, progress) -> MujocoRun:
+    build = _build(scene, dt, profile, half_step)
+    run = run_fixed_step(scene, dt, t_end, build, chunk_steps=CHUNK_STEPS, progress=progress)
+    rec = run.recording
+    return MujocoRun(
+        scene, profile, dt, rec.t, rec.states, rec.impulses, run.status, run.message, run.stats
+    )
 
 
 def simulate_mujoco(

@@ -67,9 +67,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from engines.base import build_trajectory
 from engines.quiet import quiet_import
-from engines.stepping import SPHERE_RADIUS_FRACTION, Rows, run_steps
+from engines.stepping import (
+    SPHERE_RADIUS_FRACTION,
+    Recording,
+    Rows,
+    check_dt,
+    simulate_fixed_step,
+    step_count,
+)
 from reference import quaternion as qt
 from reference.core import layout as L
 from reference.geometry import energies, initial_state
@@ -437,6 +443,12 @@ class _Stepper:
         self._drop_hits_after(self.rows_j[-1])
         return self.rows_j[-1] * self.dt
 
+    def recording(self, loop) -> Recording:
+        return _recording(self, loop)
+
+    def close(self) -> None:
+        pb.disconnect(self.h.client)
+
     def _drop_hits_after(self, j_last: int) -> None:
         """Hits of steps after the last recorded row (every step with hits is recorded)."""
         while self.hits and self.hits[-1][0] > j_last:
@@ -453,7 +465,7 @@ def simulate_pybullet(
 ) -> Trajectory:
     """Run the scene in PyBullet at fixed step dt up to t_end (scene.run.t_end by default).
 
-    Stepped by the shared run loop (engines.stepping.run_steps) in chunks of CHUNK_STEPS:
+    Driven by engines.stepping.simulate_fixed_step in chunks of CHUNK_STEPS:
     `progress(done, total)` before every chunk; Ctrl-C stops the run after the current
     step: status failed, stats["interrupted"], the steps so far kept.
 
@@ -463,67 +475,58 @@ def simulate_pybullet(
     (`engines.base`).  Status `failed` (and the run stops) on a non-finite state or when a
     contact point is more than FALL_THROUGH_DEPTH·a below its ground.
 
-    stats: wall_time_s and steps_per_s of the stepping loop (engine steps and the reads
-    it needs), steps, setup_time_s (building the world), assembly_time_s
-    (`build_trajectory`), rows_read, rows_kept, profile."""
+    stats: those of the driver (wall_time_s, steps, steps_per_s), setup_time_s (building
+    the world), rows_read, rows_kept, profile."""
     if profile not in PROFILES:
         raise ValueError(f"unknown PyBullet profile {profile!r}; choose from {PROFILES}")
-    if not dt > 0:
-        raise ValueError(f"dt must be > 0, got {dt}")
-    t_end = scene.run.t_end if t_end is None else float(t_end)
-    n_steps = max(1, int(math.ceil(t_end / dt - 1e-9)))
-    a = scene.body.radius
+    dt = check_dt(dt)
+    t_run = scene.run.t_end if t_end is None else float(t_end)
     if sample_every is None:
+        a = scene.body.radius
         time_unit = math.sqrt(a / scene.gravity) if scene.gravity > 0 else 1.0
-        sample_every = max(1, min(n_steps, int(1e-3 * time_unit / dt)))
+        sample_every = max(1, min(step_count(t_run, dt), int(1e-3 * time_unit / dt)))
     flat = scene.contacts.rim_only
-    has_plane, n_rim = scene.contacts.has_plane, scene.contacts.n_rim
-    n_contacts = scene.n_contacts
 
-    setup0 = time.perf_counter()
-    h = build_world(scene, dt, profile)
-    setup = time.perf_counter() - setup0
-    stepper = _Stepper(h, dt, sample_every, every_step=not flat, n_steps=n_steps)
-    try:
-        loop = run_steps(stepper, scene, n_steps, CHUNK_STEPS, progress, t_end=t_end)
-    finally:
-        pb.disconnect(h.client)
-    wall = loop.stepping_s
-    status, message = loop.status, loop.message
+    def build(n_steps: int) -> _Stepper:
+        setup0 = time.perf_counter()
+        h = build_world(scene, dt, profile)
+        stepper = _Stepper(h, dt, sample_every, every_step=not flat, n_steps=n_steps)
+        stepper.scene, stepper.profile = scene, profile
+        stepper.setup_s = time.perf_counter() - setup0
+        return stepper
 
-    post0 = time.perf_counter()
-    J = np.array(stepper.rows_j)
-    Y = _states(stepper.rows_raw)
-    steps_run = int(J[-1])
-    impulses = _impulses(stepper.hits, J, Y, has_plane, n_rim, n_contacts, dt)
-    keep = _rows_to_keep(J, impulses, sample_every, steps_run)
-    if status is Status.FAILED:  # keep the finite rows only
-        keep &= np.all(np.isfinite(Y), axis=1)
-    stats = {
-        "wall_time_s": wall,
-        "steps": steps_run,
-        "steps_per_s": steps_run / wall if wall > 0 else None,
-        "setup_time_s": setup,
-        "profile": profile,
-        "rows_read": int(len(J)),
-        "rows_kept": int(keep.sum()),
-    }
-    if loop.interrupted:
-        stats["interrupted"] = True
-    traj = build_trajectory(
+    return simulate_fixed_step(
         scene,
         ENGINE_NAMES[profile],
         dt,
-        J[keep] * dt,
-        Y[keep],
-        impulses[keep],
-        status,
-        message,
-        stats,
-        sample_every=1,
+        t_run,
+        build,
+        chunk_steps=CHUNK_STEPS,
+        progress=progress,
     )
-    traj.stats["assembly_time_s"] = time.perf_counter() - post0
-    return traj
+
+
+def _recording(stepper: _Stepper, loop) -> Recording:
+    """The recorded rows (finite ones only after a failure) and their impulses, thinned
+    to the regular samples and the rows around contact activity (`_rows_to_keep`)."""
+    scene, dt = stepper.scene, stepper.dt
+    contacts = scene.contacts
+    J = np.array(stepper.rows_j)
+    Y = _states(stepper.rows_raw)
+    steps_run = int(J[-1])
+    impulses = _impulses(
+        stepper.hits, J, Y, contacts.has_plane, contacts.n_rim, scene.n_contacts, dt
+    )
+    keep = _rows_to_keep(J, impulses, stepper.sample_every, steps_run)
+    if loop.status is Status.FAILED:  # keep the finite rows only
+        keep &= np.all(np.isfinite(Y), axis=1)
+    stats = {
+        "setup_time_s": stepper.setup_s,
+        "profile": stepper.profile,
+        "rows_read": int(len(J)),
+        "rows_kept": int(keep.sum()),
+    }
+    return Recording(J[keep] * dt, Y[keep], impulses[keep], steps_run, stats)
 
 
 def _states(rows: list[tuple]) -> np.ndarray:

@@ -1,9 +1,18 @@
-"""The run loop every fixed-step engine adapter plugs into (docs/engines.md).
+"""The driver every fixed-step engine adapter plugs into (docs/engines.md).
 
-An adapter builds its engine's model of the scene and wraps it in a `Stepper`: an object
-that takes steps and records rows (times and states in the reference's conventions,
-plus whatever the adapter needs afterwards, such as contact impulses).  `run_steps` drives
-it to the end time and owns what every adapter must do the same way:
+An adapter only builds its engine's model of the scene and steps it: it wraps the model in
+an `Adapter` (a `Stepper` that takes steps and records rows, plus `recording`, which
+hands over the rows in the reference's conventions with the contact impulses).
+`simulate_fixed_step` (or `run_fixed_step`, without the Trajectory) owns what every adapter
+does the same way:
+
+- the end time (scene.run.t_end unless given), the step count (`step_count`) and the
+  check of dt;
+- the stats every engine reports with the same meaning (`run_fixed_step`): wall_time_s,
+  steps, steps_per_s, interrupted;
+- the Trajectory (engines.base.build_trajectory: impacts from contact onsets).
+
+`run_steps`, the loop inside it, drives the adapter to the end time and owns:
 
 - progress: `progress(done, total)` before every chunk of steps;
 - the checks after every chunk (`first_failure`): a non-finite state, or a contact point
@@ -14,21 +23,23 @@ it to the end time and owns what every adapter must do the same way:
   so far kept (`LoopResult.interrupted`; the harness exits 130 after printing them);
 - the timing of the stepping alone (`LoopResult.stepping_s`, for stats["steps_per_s"]).
 
-The adapter then turns its rows into a Trajectory with `engines.base.build_trajectory`.
+A new engine is one module with a builder and an `Adapter`, plus its entry point
+(engines/builtin.py and pyproject.toml).
 """
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
 
 from reference.geometry import scene_contact_kinematics
 from reference.scene import Scene
-from reference.trajectory import Status
+from reference.trajectory import Status, Trajectory
 
 # Radius of the engines' contact spheres (one per vertex, or the bumps), in units of the
 # body radius a.  Any value from 1e-2 to 1e-6 gave the same impacts (docs/engines.md); it
@@ -144,3 +155,125 @@ def run_steps(
         message = f"{reason} at t = {t_last:.6g}; the steps before are kept"
         return LoopResult(Status.FAILED, message, done, stepping, interrupted=True)
     return LoopResult(status, message, done, stepping)
+
+
+# --------------------------------------------------------------------------- the driver
+def step_count(t_end: float, dt: float) -> int:
+    """Steps of a fixed-step run to t_end: the fewest that reach t_end (to 1e-9 of a
+    step, so that t_end/dt = 1000.0000000001 is 1000 steps), at least one."""
+    return max(1, math.ceil(t_end / dt - 1e-9))
+
+
+def check_dt(dt: float) -> float:
+    """dt as a float; ValueError unless it is a positive finite number."""
+    dt = float(dt)
+    if not (dt > 0.0 and math.isfinite(dt)):
+        raise ValueError(f"dt must be > 0, got {dt}")
+    return dt
+
+
+@dataclass
+class Recording:
+    """What an adapter hands over after the loop, in the reference's conventions:
+    times (N,), states (N, 13), normal impulses (N, k) per contact on the row of the
+    state they were computed at (engines.base), the steps taken, the adapter's own stats
+    (its parameters; `compile_time_s` for an engine that compiles before it steps, which
+    wall_time_s then leaves out) and the sample thinning for the Trajectory."""
+
+    t: np.ndarray
+    states: np.ndarray
+    impulses: np.ndarray
+    steps: int
+    stats: dict = field(default_factory=dict)
+    sample_every: int = 1
+
+
+class Adapter(Stepper, Protocol):
+    """A `Stepper` that also hands over its rows (`run_fixed_step`)."""
+
+    def recording(self, loop: LoopResult) -> Recording:
+        """The rows recorded (after `cut` or `settle`, when the loop called them)."""
+        ...
+
+
+@dataclass
+class FixedStepRun:
+    """One run of `run_fixed_step`."""
+
+    recording: Recording
+    status: Status
+    message: str
+    stats: dict
+
+
+def run_fixed_step(
+    scene: Scene,
+    dt: float,
+    t_end: float | None,
+    build: Callable[[int], Adapter],
+    *,
+    chunk_steps: int | None = None,
+    progress: Progress | None = None,
+) -> FixedStepRun:
+    """Build the engine's model (`build(n_steps)` returns its Adapter), drive it with
+    `run_steps` to t_end (scene.run.t_end by default) in chunks of chunk_steps (None: one
+    chunk) and collect its Recording.  An adapter with a `close()` method is closed
+    afterwards, also on error.
+
+    stats, with one meaning for every engine: wall_time_s, the wall time of the engine's
+    run (building the model, stepping, converting its output to the reference's
+    conventions; not the Trajectory's assembly, and not a JIT compilation, which the
+    adapter reports as compile_time_s); steps; steps_per_s, steps per second of the
+    stepping alone; interrupted (only when Ctrl-C stopped the run); then the adapter's."""
+    dt = check_dt(dt)
+    t_end = scene.run.t_end if t_end is None else float(t_end)
+    n_steps = step_count(t_end, dt)
+    t_wall = time.perf_counter()
+    adapter = build(n_steps)
+    try:
+        loop = run_steps(adapter, scene, n_steps, chunk_steps or n_steps, progress, t_end)
+        rec = adapter.recording(loop)
+    finally:
+        close = getattr(adapter, "close", None)
+        if close is not None:
+            close()
+    wall = time.perf_counter() - t_wall - float(rec.stats.get("compile_time_s", 0.0))
+    stats = {
+        "wall_time_s": wall,
+        "steps": rec.steps,
+        "steps_per_s": rec.steps / loop.stepping_s if loop.stepping_s > 0 else None,
+    }
+    if loop.interrupted:
+        stats["interrupted"] = True
+    stats.update(rec.stats)
+    return FixedStepRun(rec, loop.status, loop.message, stats)
+
+
+def simulate_fixed_step(
+    scene: Scene,
+    engine: str,
+    dt: float,
+    t_end: float | None,
+    build: Callable[[int], Adapter],
+    *,
+    chunk_steps: int | None = None,
+    progress: Progress | None = None,
+) -> Trajectory:
+    """`run_fixed_step`, then the Trajectory named `engine` (engines.base.build_trajectory:
+    samples thinned by the Recording's sample_every, impacts from every recorded row)."""
+    from .base import build_trajectory
+
+    run = run_fixed_step(scene, dt, t_end, build, chunk_steps=chunk_steps, progress=progress)
+    rec = run.recording
+    return build_trajectory(
+        scene,
+        engine,
+        check_dt(dt),
+        rec.t,
+        rec.states,
+        rec.impulses,
+        run.status,
+        run.message,
+        run.stats,
+        rec.sample_every,
+    )

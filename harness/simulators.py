@@ -55,6 +55,31 @@ class EngineLoadError(SceneError):
     """An engine that is missing or cannot be loaded (exit status 2)."""
 
 
+class EngineNotInstalled(EngineLoadError):
+    """A registered engine whose physics library is not installed: its pip extra was
+    not chosen (exit status 2 when it is asked to run; `harness engines` lists it)."""
+
+
+def install_hint(extra: str) -> str:
+    """The command that installs an extra of this package."""
+    return f"pip install 'euler-disk-harness[{extra}]'"
+
+
+def _check_library(name: str, obj: Callable) -> None:
+    """EngineNotInstalled when the engine names the extra of a library that is missing."""
+    library, extra = attribute(obj, "library"), attribute(obj, "extra")
+    if library is None or extra is None:
+        return
+    from importlib import metadata  # here: its import costs every command's start-up
+
+    try:
+        metadata.version(library)
+    except metadata.PackageNotFoundError:
+        raise EngineNotInstalled(
+            f"engine {name!r} needs {library}, which is not installed: {install_hint(extra)}"
+        ) from None
+
+
 @functools.cache
 def _discovered() -> dict[str, EngineInfo]:
     from importlib import metadata  # here: its import costs every command's start-up
@@ -123,9 +148,18 @@ def engine_names() -> list[str]:
     return first + sorted(names - set(first))
 
 
-def load_engine(name: str) -> Callable:
-    """The engine's `simulate` callable (EngineLoadError if missing or broken)."""
+def entry_point(name: str) -> Callable:
+    """The engine's entry point, loaded, whether or not its library is installed
+    (EngineLoadError if it is not registered or broken)."""
     return _loaded(name)
+
+
+def load_engine(name: str) -> Callable:
+    """The engine's `simulate` callable (EngineLoadError if missing or broken,
+    EngineNotInstalled when its library, from a pip extra, is missing)."""
+    obj = _loaded(name)
+    _check_library(name, obj)
+    return obj
 
 
 def is_fixed_step(name: str) -> bool:
@@ -181,6 +215,34 @@ def run_simulator(
     if not isinstance(traj, Trajectory):
         raise TypeError(f"engine {engine!r} returned {type(traj).__name__}, not a Trajectory")
     return guard_trajectory(scene, traj)
+
+
+def offers_batch(engine: str) -> bool:
+    """Whether the engine offers `simulate_batch` (engines.interface.Engine)."""
+    return attribute(load_engine(engine), "simulate_batch") is not None
+
+
+def run_batch(
+    engine: str, scenes: list[Scene], dt: float | None = None, t_end: float | None = None
+) -> list[Trajectory]:
+    """Run many scenes at one dt: through the engine's `simulate_batch` when it offers
+    one, serially through `run_simulator` otherwise.  Every scene is checked first
+    (`check_run`) and every result guarded, as `run_simulator` does; t_end None: each
+    scene's own run.t_end.  A batch that raises falls back to the serial runs."""
+    from reference.scenes import as_scene
+
+    from .guard import guard_trajectory
+
+    scenes = [as_scene(s) for s in scenes]
+    batch = attribute(load_engine(engine), "simulate_batch")
+    if batch is None or not scenes:
+        return [run_simulator(engine, s, dt, t_end) for s in scenes]
+    steps = {check_run(engine, s, dt, t_end) for s in scenes}
+    try:
+        trajs = batch(scenes, dt=steps.pop(), t_end=t_end)
+    except Exception:  # the batch broke or refused: each scene on its own says why
+        return [run_simulator(engine, s, dt, t_end) for s in scenes]
+    return [guard_trajectory(s, tr) for s, tr in zip(scenes, trajs, strict=True)]
 
 
 def _error_text(exc: BaseException, limit: int = 2000) -> str:

@@ -1,6 +1,11 @@
-"""Shared fixtures: scenes built in code (independent of the shipped TOML files)."""
+"""Shared fixtures: scenes built in code (independent of the shipped TOML files), and the
+rule for engines that come with a pip extra: their tests are skipped with a one-line reason
+where the extra is missing (`require_extra`), and a CI run (environment CI=true, .ci/run)
+fails when any of them was skipped, since CI installs every extra (`make test`)."""
 
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import pytest
@@ -100,3 +105,50 @@ def empty_output():
         np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
         np.zeros((1, 6)), np.zeros(1), np.zeros(5, dtype=np.int64),
     )  # fmt: skip
+
+
+# ------------------------------------------------------------------ engines as extras
+# The start of the reason of every skip for a missing extra (the CI check counts them).
+MISSING_EXTRA = "engine extra missing"
+_missing_extra_skips: list[str] = []
+
+
+def require_extra(module: str, extra: str):
+    """The module of an engine installed by the pip extra `extra`; the test (or the whole
+    test module, at import) is skipped with a one-line reason when it is not installed."""
+    return pytest.importorskip(
+        module,
+        reason=f"{MISSING_EXTRA}: {module} (pip install 'euler-disk-harness[{extra}]')",
+    )
+
+
+def _ci() -> bool:
+    return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")
+
+
+def _note_missing_extra(report) -> None:
+    if report.skipped and MISSING_EXTRA in str(report.longrepr):
+        _missing_extra_skips.append(report.nodeid)
+
+
+def pytest_collectreport(report) -> None:
+    _note_missing_extra(report)
+
+
+def pytest_runtest_logreport(report) -> None:
+    _note_missing_extra(report)
+
+
+def pytest_sessionfinish(session, exitstatus) -> None:
+    """In CI every engine's tests run: a skip for a missing extra fails the session."""
+    if _ci() and _missing_extra_skips and session.exitstatus == 0:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    if _ci() and _missing_extra_skips:
+        terminalreporter.write_line(
+            f"CI: {len(_missing_extra_skips)} engine test(s) skipped for a missing extra "
+            f"(CI installs every extra; `make test`): {', '.join(_missing_extra_skips[:5])}",
+            red=True,
+        )

@@ -13,6 +13,7 @@ from engines.mujoco import set_state, simulate_mujoco
 from engines.mujoco_model import contact_geom_pairs, load_model
 from harness.transition.scene import transition_scene
 from reference import quaternion as qt
+from tests.conftest import require_extra
 from tests.oracle.simulate import simulate as oracle_simulate
 
 N = 20
@@ -110,6 +111,7 @@ def test_drake_bumpy_model_never_collides_the_face_with_the_half_space(short_sce
     """The face box's corner 0.006 a into the half space, the vertices 1e-4 a above it
     and the bumps far below the face: Drake reports no contact (the filter excludes
     the face–half space pair)."""
+    require_extra("pydrake", "drake")
     from engines import drake as dk
 
     y = _tilted_over_the_corner(short_scene, 1e-4 * short_scene.body.radius)
@@ -125,6 +127,7 @@ def test_drake_bumpy_model_reports_the_reference_gaps_of_both_kinds(short_scene)
     """Centre at the bumps' height, tilted 4.5e-3: vertices on the low side below the
     plane, bumps on the low side above the face; every pair Drake reports is a scene
     contact of either kind at depth −gap (1e-12)."""
+    require_extra("pydrake", "drake")
     from engines import drake as dk
 
     y = _state(short_scene.ground.bump_height, (0.004, -0.002, 0.0))

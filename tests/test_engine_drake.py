@@ -9,13 +9,17 @@ import math
 import numpy as np
 import pytest
 
-from engines import drake as dk
-from engines.base import contact_kinematics, effective_contact_mass
-from harness.restitution.drops import drop_scene, watched_point
-from harness.restitution.impact import read_impact
-from reference import quaternion as qt
-from reference.geometry import initial_state
-from tests.conftest import make_scene
+from tests.conftest import require_extra
+
+require_extra("pydrake", "drake")
+
+from engines import drake as dk  # noqa: E402
+from engines.base import contact_kinematics, effective_contact_mass  # noqa: E402
+from harness.restitution.drops import drop_scene, watched_point  # noqa: E402
+from harness.restitution.impact import read_impact  # noqa: E402
+from reference import quaternion as qt  # noqa: E402
+from reference.geometry import initial_state  # noqa: E402
+from tests.conftest import make_scene  # noqa: E402
 
 SPINNING = np.concatenate(
     [[0.1, -0.2, 0.9], qt.from_rotation_vector([0.3, -0.5, 1.1]), [0.2, 0.1, -0.3]]

@@ -7,7 +7,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engines.stepping import FALL_THROUGH_DEPTH, Rows, run_steps
+from engines.stepping import (
+    FALL_THROUGH_DEPTH,
+    Recording,
+    Rows,
+    run_fixed_step,
+    run_steps,
+    step_count,
+)
 from reference.trajectory import Status
 from tests.conftest import make_scene
 
@@ -91,3 +98,63 @@ def test_the_rows_do_not_depend_on_the_chunk_size(chunk):
     stepper = Sinking(z0=1.0, speed=1.0, dt=1e-3)
     run_steps(stepper, make_scene(n=5), 300, chunk, t_end=0.3)
     np.testing.assert_array_equal(np.array(stepper.rows)[:, 2], 1.0 - 1e-3 * np.arange(301))
+
+
+# ------------------------------------------------------------------ the driver
+class Recorded(Sinking):
+    """A Sinking adapter for the driver: hands over its rows, reports a compile time,
+    and notes that it was closed."""
+
+    compile_s = 0.0
+    closed = False
+
+    def recording(self, loop) -> Recording:
+        states = np.array(self.rows)
+        impulses = np.zeros((len(states), 5))
+        stats = {"compile_time_s": self.compile_s, "mine": 1}
+        return Recording(self.dt * np.arange(len(states)), states, impulses, len(states) - 1, stats)
+
+    def close(self) -> None:
+        self.closed = True
+
+
+@pytest.mark.parametrize(
+    ("t_end", "dt", "steps"),
+    [(1.0, 1e-3, 1000), (1.0000000000001, 1e-3, 1000), (1.0005, 1e-3, 1001)],
+)
+def test_the_step_count_is_the_fewest_steps_that_reach_t_end(t_end, dt, steps):
+    assert step_count(t_end, dt) == steps
+    assert step_count(1e-9, 1.0) == 1
+
+
+def test_the_driver_defaults_t_end_counts_steps_and_closes_the_adapter():
+    scene = make_scene(n=5, t_end=0.05)
+    made = []
+
+    def build(n_steps):
+        made.append(n_steps)
+        made.append(Recorded(z0=1.0, speed=0.0, dt=1e-3))
+        return made[-1]
+
+    run = run_fixed_step(scene, 1e-3, None, build, chunk_steps=20)
+    assert made[0] == 50 and made[1].closed and made[1].advances == [20, 20, 10]
+    assert run.status is Status.T_END and run.stats["steps"] == 50 and run.stats["mine"] == 1
+    assert run.stats["steps_per_s"] > 0 and run.stats["wall_time_s"] >= 0
+
+
+def test_wall_time_leaves_out_the_compile_time_the_adapter_reports():
+    scene = make_scene(n=5, t_end=0.01)
+
+    def build(n_steps):
+        adapter = Recorded(z0=1.0, speed=0.0, dt=1e-3)
+        adapter.compile_s = 1e6  # far longer than the run itself
+        return adapter
+
+    run = run_fixed_step(scene, 1e-3, None, build)
+    assert run.stats["compile_time_s"] == 1e6 and run.stats["wall_time_s"] < 0
+
+
+@pytest.mark.parametrize("dt", [0.0, -1e-3, float("nan"), float("inf")])
+def test_the_driver_refuses_a_step_that_is_not_positive_and_finite(dt):
+    with pytest.raises(ValueError, match="dt must be > 0"):
+        run_fixed_step(make_scene(), dt, None, lambda n: Recorded(1.0, 0.0, 1e-3))

@@ -86,7 +86,8 @@ def test_listing_engines_and_running_the_reference_import_no_physics_engine():
         "from harness.cli import main\n"
         "assert main(['engines']) == 0\n"
         "assert main(['simulate', 'pentagon-bounce', '--t-end', '0.3']) == 0\n"
-        "heavy = [m for m in ('mujoco', 'pybullet', 'pydrake') if m in sys.modules]\n"
+        "heavy = ('mujoco', 'pybullet', 'pydrake', 'dartpy', 'jax', 'distributed', 'dask')\n"
+        "heavy = [m for m in heavy if m in sys.modules]\n"
         "assert not heavy, heavy\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, cwd=ROOT)
@@ -116,6 +117,92 @@ def test_pip_installed_plugin_appears_and_runs_without_changing_this_package(tmp
     )
     assert compared.returncode == 0, compared.stderr.decode()
     assert json.loads(compared.stdout)["engines"][0]["impacts_matched"] >= 4
+
+
+@pytest.fixture
+def missing_extra(tmp_path, monkeypatch):
+    """An engine whose library (a distribution that is not installed) comes from an
+    extra named `ghost`."""
+    _dist_info(tmp_path, "ghost-engine", "1.0", "ghost = ghost_engine:simulate")
+    (tmp_path / "ghost_engine.py").write_text(
+        "from engines.interface import engine_entry\n"
+        "@engine_entry(library='no-such-distribution-x7', extra='ghost')\n"
+        "def simulate(scene, *, dt=None, t_end=None):\n"
+        "    raise AssertionError('never run')\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    simulators.refresh()
+    yield
+    simulators.refresh()
+
+
+def test_harness_engines_names_the_extra_of_an_engine_that_is_not_installed(missing_extra, capsys):
+    assert main(["engines", "--json"]) == 0  # a missing extra is a choice, not an error
+    rows = {r["name"]: r for r in json.loads(capsys.readouterr().out)["engines"]}
+    ghost = rows["ghost"]
+    assert ghost["installed"] is False and ghost["error"] is None and ghost["extra"] == "ghost"
+    assert ghost["install"] == "pip install 'euler-disk-harness[ghost]'"
+    assert rows["mujoco"]["installed"] is True and rows["mujoco"]["extra"] is None
+    assert main(["engines"]) == 0
+    assert "not installed: pip install 'euler-disk-harness[ghost]'" in capsys.readouterr().out
+
+
+def test_running_an_engine_whose_extra_is_missing_is_one_line_exit_2(missing_extra, capsys):
+    code = main(["simulate", "pentagon-bounce", "--engine", "ghost", "--t-end", "0.01"])
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert code == 2 and len(err) == 1
+    assert "pip install 'euler-disk-harness[ghost]'" in err[0]
+
+
+@pytest.fixture
+def batching(tmp_path, monkeypatch):
+    """An engine `batchy` (MuJoCo underneath) that offers simulate_batch and counts its
+    calls in `batchy_engine.CALLS`."""
+    _dist_info(tmp_path, "batchy-engine", "1.0", "batchy = batchy_engine:simulate")
+    (tmp_path / "batchy_engine.py").write_text(
+        "from engines.builtin import mujoco\n"
+        "from engines.interface import engine_entry\n"
+        "CALLS = []\n"
+        "@engine_entry(fixed_step=True)\n"
+        "def simulate(scene, *, dt, t_end=None):\n"
+        "    return mujoco(scene, dt=dt, t_end=t_end)\n"
+        "def simulate_batch(scenes, *, dt, t_end=None):\n"
+        "    CALLS.append(len(scenes))\n"
+        "    return [mujoco(s, dt=dt, t_end=t_end) for s in scenes]\n"
+        "simulate.simulate_batch = simulate_batch\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    simulators.refresh()
+    import batchy_engine
+
+    batchy_engine.CALLS.clear()
+    yield batchy_engine
+    simulators.refresh()
+
+
+def test_run_batch_uses_the_engines_batch_and_gives_the_serial_runs(batching):
+    from tests.conftest import make_scene
+
+    scenes = [make_scene(n=5, t_end=0.3), make_scene(n=5, q=(0.02, 0.0, 0.05), t_end=0.3)]
+    assert simulators.offers_batch("batchy") and not simulators.offers_batch("mujoco")
+    batch = simulators.run_batch("batchy", scenes, 1e-4)
+    assert batching.CALLS == [2]
+    for sc, b in zip(scenes, batch, strict=True):
+        serial = simulators.run_simulator("mujoco", sc, 1e-4)
+        assert (b.t == serial.t).all() and (b.position == serial.position).all()
+        assert [e.t for e in b.impacts] == [e.t for e in serial.impacts]
+    fallback = simulators.run_batch("mujoco", scenes, 1e-4)  # no batch: serial runs
+    assert [len(t.impacts) for t in fallback] == [len(t.impacts) for t in batch]
+
+
+def test_restitution_runs_each_dt_and_phase_as_one_batch(batching):
+    from harness.restitution.study import Grid, run_study
+
+    grid = Grid(gammas=(0.5, 0.8), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
+    rows = run_study(["batchy"], grid)["engines"][0]["rows"]
+    assert batching.CALLS == [2, 2, 2]  # three onset phases, two gammas each
+    plain = run_study(["mujoco"], grid)["engines"][0]["rows"]
+    assert [r["e_eff"] for r in rows] == [r["e_eff"] for r in plain]
 
 
 def test_the_builtin_engines_loaded_without_metadata_are_the_ones_pyproject_registers():

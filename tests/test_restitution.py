@@ -12,6 +12,7 @@ from harness.cli import main
 from harness.restitution.drops import drop_scene, watched_point
 from harness.restitution.study import EVENT_LEAD, Grid, run_study
 from reference.geometry import initial_state
+from tests.conftest import require_extra
 from tests.oracle.body import BodyModel
 from tests.oracle.impact import impact_impulse
 
@@ -73,7 +74,8 @@ def test_engine_bounces_within_one_percent_at_dt_1e4_fast_impacts(engine):
     """A fast vertex impact (u⁻ = 1) at dt = 1e-4, γ = 0.8, at the three default onset
     phases: every adapter's mapping gives γ within 1 %, loses energy (no gain) and
     penetrates for a finite time."""
-    pytest.importorskip({"drake": "pydrake"}.get(engine, engine))
+    if engine == "drake":
+        require_extra("pydrake", "drake")
     grid = Grid(gammas=(0.8,), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
     rows = run_study([engine], grid)["engines"][0]["rows"]
     assert len(rows) == 3
@@ -87,7 +89,7 @@ def test_engine_bounces_within_one_percent_at_dt_1e4_fast_impacts(engine):
 def test_drake_sap_bounce_depends_on_the_onset_phase():
     """SAP's mapping is exact at the middle phase; at γ = 0.3 (16-step contact) an onset
     early in the step bounces more than γ and a late one less, by more than 1 %."""
-    pytest.importorskip("pydrake")
+    require_extra("pydrake", "drake")
     grid = Grid(gammas=(0.3,), speeds=(1.0,), dts=(1e-4,), geometries=("vertex",))
     rows = run_study(["drake"], grid)["engines"][0]["rows"]
     err = {r["phase"]: r["e_error"] for r in rows}

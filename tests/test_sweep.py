@@ -18,6 +18,7 @@ from harness.sweep import exponent_sweep
 from harness.sweep.grid import SweepConfig, initial_state
 from harness.sweep.store import StoreError, SweepStore, load_results
 from reference.trajectory import ImpactEvent, Status, Trajectory
+from tests.conftest import require_extra
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULT_COLUMNS = [
@@ -96,7 +97,7 @@ def local_run(tmp_path_factory):
 
 
 def test_local_and_dask_executors_give_identical_rows(local_run, tmp_path):
-    distributed = pytest.importorskip("distributed")
+    distributed = require_extra("distributed", "dask")
     out_local, _ = local_run
     with distributed.LocalCluster(
         n_workers=1,

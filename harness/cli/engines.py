@@ -1,9 +1,13 @@
-"""`harness engines`: every installed engine, its package and version, and whether it loads.
+"""`harness engines`: every registered engine, its package and version, whether its
+physics library is installed (and, when not, the pip extra that installs it), and whether
+it loads.
 
-Each engine is loaded (its entry point imported) to read `fixed_step` and to show that it
-works; the built-in entry points import their engines only when run, so this does not
-import MuJoCo, PyBullet or Drake.  Exit status 2 when an engine fails to load (each one
-named with the reason on stderr; the others are still listed).
+Each engine is loaded (its entry point imported) to read `fixed_step`, `library` and
+`extra` and to show that it works; the built-in entry points import their engines only
+when run, so this does not import MuJoCo, PyBullet, Drake, DART or JAX.  An engine whose
+library is missing is listed as "not installed" with its install command (exit status 0:
+that is a choice of extras, not an error).  Exit status 2 when an engine fails to load
+(each one named with the reason on stderr; the others are still listed).
 """
 
 from __future__ import annotations
@@ -25,7 +29,14 @@ def engine_rows() -> list[dict]:
     from engines.interface import attribute
 
     from ..provenance import distribution_version
-    from ..simulators import EngineLoadError, engine_infos, is_fixed_step, load_engine
+    from ..simulators import (
+        EngineLoadError,
+        EngineNotInstalled,
+        engine_infos,
+        entry_point,
+        install_hint,
+        load_engine,
+    )
 
     rows = []
     for info in engine_infos():
@@ -37,16 +48,34 @@ def engine_rows() -> list[dict]:
             "fixed_step": None,
             "library": None,
             "library_version": None,
+            "extra": None,
+            "installed": False,
+            "install": None,
             "error": None,
         }
         try:
-            row["fixed_step"] = is_fixed_step(info.name)
-            row["library"] = attribute(load_engine(info.name), "library")
+            obj = entry_point(info.name)
+            row["fixed_step"] = bool(attribute(obj, "fixed_step"))
+            row["library"] = attribute(obj, "library")
+            row["extra"] = attribute(obj, "extra")
             row["library_version"] = distribution_version(row["library"])
+            load_engine(info.name)
+            row["installed"] = True
+        except EngineNotInstalled:
+            row["library_version"] = None
+            row["install"] = install_hint(row["extra"])
         except EngineLoadError as exc:
             row["error"] = str(exc)
         rows.append(row)
     return rows
+
+
+def _status(row: dict) -> str:
+    if row["error"] is not None:
+        return "FAILS TO LOAD"
+    if not row["installed"]:
+        return f"not installed: {row['install']}"
+    return "ok"
 
 
 def run(args) -> int:
@@ -61,8 +90,8 @@ def run(args) -> int:
                 {True: "yes", False: "no (event-driven)", None: "-"}[r["fixed_step"]],
                 r["package"] or "-",
                 r["version"] or "-",
-                f"{r['library']} {r['library_version']}" if r["library"] else "-",
-                "ok" if r["error"] is None else "FAILS TO LOAD",
+                f"{r['library']} {r['library_version'] or ''}".strip() if r["library"] else "-",
+                _status(r),
             ]
             for r in rows
         ],

@@ -197,6 +197,13 @@ def check_scheduler(scheduler: str, timeout_s: float = 5.0) -> None:
         raise ExecutorError(
             f"cannot connect to the Dask scheduler at {scheduler}: {exc.strerror or exc}"
         ) from None
+    import importlib.util
+
+    if importlib.util.find_spec("distributed") is None:
+        raise ExecutorError(
+            f"the Dask scheduler at {scheduler} needs dask.distributed here: "
+            "pip install 'euler-disk-harness[dask]'"
+        )
 
 
 def run_dask(

@@ -3,12 +3,13 @@ every vertex a one-step velocity projection (Newton's law vₙ⁺ = −γ vₙ�
 penetrate and approach, solved one contact at a time, Gauss–Seidel).
 
 It shows what an engine adapter does (docs/engines.md): build the scene's body (from the
-harness's `engines.base` helpers); wrap the stepping in a Stepper (`ToyStepper`) that the
-harness's run loop `engines.stepping.run_steps` drives (progress, checks for a
-non-finite state or a fall-through, Ctrl-C); hand the per-step states (reference
-conventions: x, q wxyz, v, ω world) and per-contact normal impulses to
-`build_trajectory`, which finds the impacts (contact onsets), energies and the impact
-budget; declare the entry point's attributes with `engines.interface.engine_entry`.
+harness's `engines.base` helpers); wrap the stepping in an Adapter (`ToyStepper`) that the
+harness's driver `engines.stepping.simulate_fixed_step` runs (end time and step count,
+progress, checks for a non-finite state or a fall-through, Ctrl-C, the common stats); hand
+it the per-step states (reference conventions: x, q wxyz, v, ω world) and per-contact
+normal impulses (`recording`), from which it builds the Trajectory (impacts from contact
+onsets, energies, the impact budget); declare the entry point's attributes with
+`engines.interface.engine_entry`.
 Flat ground only.
 """
 
@@ -16,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from engines.base import build_trajectory, initial_state, scene_points
+from engines.base import initial_state, scene_points
 from engines.interface import engine_entry
-from engines.stepping import Rows, run_steps
+from engines.stepping import Recording, Rows, simulate_fixed_step
 from reference.scene import Scene, SceneError
 from reference.trajectory import Trajectory
 
@@ -112,24 +113,27 @@ class ToyStepper:
         del self.states[kept:], self.impulses[kept:]
         return self.dt * (kept - 1)
 
+    def recording(self, loop) -> Recording:
+        """The rows for the driver: every step's state and impulses."""
+        states, impulses = np.array(self.states), np.array(self.impulses)
+        t = self.dt * np.arange(len(states))
+        return Recording(t, states, impulses, len(states) - 1, {"toy_engine_version": __version__})
+
 
 @engine_entry(fixed_step=True, reports_progress=True)
 def simulate(scene: Scene, *, dt: float, t_end: float | None = None, progress=None) -> Trajectory:
     """The entry point: `harness` calls it with the scene, the step and the end time (and
-    a progress callback, since it says `reports_progress`)."""
+    a progress callback, since it says `reports_progress`).  The shared driver sets the
+    end time and step count, runs the loop, fills the common stats and builds the
+    Trajectory."""
     if scene.ground.kind != "flat":
         raise SceneError("the toy engine models flat ground only")
-    t_end = scene.run.t_end if t_end is None else float(t_end)
-    n = max(1, int(round(t_end / dt)))
-    stepper = ToyStepper(scene, dt)
-    loop = run_steps(stepper, scene, n, CHUNK_STEPS, progress, t_end=t_end)
-    states, impulses = np.array(stepper.states), np.array(stepper.impulses)
-    t = dt * np.arange(len(states))
-    stats = {
-        "steps": len(states) - 1,
-        "steps_per_s": (len(states) - 1) / loop.stepping_s if loop.stepping_s > 0 else None,
-        "toy_engine_version": __version__,
-    }
-    if loop.interrupted:
-        stats["interrupted"] = True
-    return build_trajectory(scene, "toy", dt, t, states, impulses, loop.status, loop.message, stats)
+    return simulate_fixed_step(
+        scene,
+        "toy",
+        dt,
+        t_end,
+        lambda n_steps: ToyStepper(scene, dt),
+        chunk_steps=CHUNK_STEPS,
+        progress=progress,
+    )

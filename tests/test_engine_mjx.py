@@ -1,0 +1,130 @@
+"""MJX adapter: the model is the `mujoco` engine's with diagexact off; float64 MJX steps
+as MuJoCo C does on that model; `mjx` and `mujoco` give the same impact on
+pentagon-bounce at dt = 1e-4 … 1e-9 while MuJoCo follows the reference; a vmapped batch
+gives the serial runs' trajectories."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from tests.conftest import require_extra
+
+require_extra("jax", "mjx")
+require_extra("mujoco.mjx", "mjx")
+
+import mujoco  # noqa: E402
+
+from engines import mjx as mx  # noqa: E402
+from engines.mujoco import simulate_mujoco, staggered_start, to_mujoco_state  # noqa: E402
+from engines.mujoco_model import load_model  # noqa: E402
+from reference import quaternion as qt  # noqa: E402
+from reference.scene import InitialState  # noqa: E402
+from reference.scenes import as_scene  # noqa: E402
+from reference.simulate import simulate  # noqa: E402
+
+STEPS = 60  # steps of each short run: 30 before the first impact, 30 after
+
+
+@pytest.fixture(scope="module")
+def bounce():
+    """pentagon-bounce and the reference's first impact."""
+    scene = as_scene("pentagon-bounce")
+    return scene, simulate(scene, t_end=0.2).impacts[0]
+
+
+def _before_impact(scene, t_impact: float, dt: float):
+    """The scene restarted from the reference's state (STEPS/2 − 1/2)·dt before its
+    first impact, run for STEPS steps: the impact falls mid-step (on a step boundary the
+    onset would be decided by roundoff)."""
+    t0 = t_impact - (0.5 * STEPS - 0.5) * dt
+    ref = simulate(scene, t_end=t0)
+    y = np.concatenate([ref.position[-1], ref.quaternion[-1], ref.velocity[-1]])
+    y = np.concatenate([y, ref.angular_velocity[-1]])
+    initial = InitialState(
+        tuple(y[0:3]), tuple(qt.to_rotation_vector(y[3:7])), tuple(y[7:10]), tuple(y[10:13])
+    )
+    return dataclasses.replace(scene, initial=initial).with_run(t_end=STEPS * dt), t0
+
+
+def test_model_is_the_mujoco_engines_with_diagexact_off(bounce):
+    scene, _ = bounce
+    ours, theirs = mx.build_model(scene, 1e-4), load_model(scene, 1e-4, "tuned")
+    diagexact = int(mujoco.mjtEnableBit.mjENBL_DIAGEXACT)
+    assert theirs.opt.enableflags & diagexact
+    assert ours.opt.enableflags == theirs.opt.enableflags & ~diagexact
+    for field in ("geom_size", "geom_pos", "geom_solref", "geom_solimp", "body_inertia"):
+        assert np.array_equal(getattr(ours, field), getattr(theirs, field))
+    assert ours.opt.timestep == theirs.opt.timestep and ours.opt.integrator == 0
+
+
+def test_float64_mjx_steps_as_mujoco_c_on_the_same_model(bounce):
+    scene, first = bounce
+    dt = 1e-4
+    short, _ = _before_impact(scene, first.t, dt)
+    run = mx.simulate_mjx(short, dt)
+    model = mx.build_model(short, dt)
+    data = mujoco.MjData(model)
+    y0 = staggered_start(short, _y0(short), dt)
+    data.qpos[:], data.qvel[:] = to_mujoco_state(y0)
+    heights = []
+    for _ in range(STEPS):
+        mujoco.mj_step(model, data)
+        heights.append(data.qpos[2])
+    assert len(run.impacts) >= 1
+    assert np.max(np.abs(run.position[1:, 2] - np.array(heights))) < 1e-12
+
+
+def _y0(scene):
+    from reference.geometry import initial_state
+
+    return initial_state(scene.initial)
+
+
+@pytest.mark.parametrize("dt", [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9])
+def test_mjx_and_mujoco_give_the_same_impact_while_mujoco_follows_the_reference(bounce, dt):
+    scene, first = bounce
+    short, t0 = _before_impact(scene, first.t, dt)
+    ours, theirs = mx.simulate_mjx(short, dt), simulate_mujoco(short, dt)
+    assert [e.contact for e in ours.impacts] == [e.contact for e in theirs.impacts]
+    assert [e.contact for e in theirs.impacts][:1] == [first.contact]
+    assert abs(theirs.impacts[0].t + t0 - first.t) < 2 * dt  # MuJoCo follows the reference
+    for a, b in zip(ours.impacts, theirs.impacts, strict=True):
+        assert abs(a.t - b.t) < 1e-3 * dt
+        assert a.v_normal_post == pytest.approx(b.v_normal_post, rel=1e-3)
+
+
+def test_a_vmapped_batch_gives_the_serial_trajectories(bounce):
+    scene, first = bounce
+    dt = 1e-4
+    short, _ = _before_impact(scene, first.t, dt)
+    y = _y0(short)
+    spun = dataclasses.replace(
+        short,
+        initial=dataclasses.replace(
+            short.initial, angular_velocity=tuple(np.array(y[10:13]) + [0.0, 0.0, 0.3])
+        ),
+    )
+    scenes = [short, spun]
+    batch = mx.simulate_mjx_batch(scenes, dt=dt)
+    for sc, b in zip(scenes, batch, strict=True):
+        serial = mx.simulate_mjx(sc, dt)
+        assert b.status == serial.status and len(b.t) == len(serial.t)
+        assert np.allclose(b.position, serial.position, rtol=0, atol=1e-12)
+        assert np.allclose(b.angular_velocity, serial.angular_velocity, rtol=0, atol=1e-10)
+        assert [e.contact for e in b.impacts] == [e.contact for e in serial.impacts]
+        assert [e.t for e in b.impacts] == pytest.approx([e.t for e in serial.impacts], abs=1e-12)
+    assert not np.allclose(batch[0].angular_velocity, batch[1].angular_velocity)
+
+
+def test_float32_mjx_runs_in_float32_and_finds_the_impact(bounce):
+    scene, first = bounce
+    dt = 1e-4
+    short, t0 = _before_impact(scene, first.t, dt)
+    run = mx.simulate_mjx(short, dt, precision="float32")
+    assert run.engine == "mjx-f32" and run.stats["precision"] == "float32"
+    assert [e.contact for e in run.impacts][:1] == [first.contact]
+    assert abs(run.impacts[0].t + t0 - first.t) < 2 * dt
+    assert run.stats["compile_time_s"] >= 0 and run.stats["wall_time_s"] > 0
