@@ -37,7 +37,7 @@ def format_simulate(
     if traj.t_singularity is not None:
         lines.append(f"t_sing      {traj.t_singularity:.17g}")
     lines += [
-        f"impacts     {len(traj.impacts)}",
+        f"impacts     {len(traj.impacts)}{_simultaneous_text(traj)}",
         f"samples     {traj.n_samples}",
         f"energy      {e[0]:.6e} -> {e[-1]:.6e}" if traj.n_samples else "energy      -",
         f"wall time   {traj.stats.get('wall_time_s', float('nan')):.3f} s",
@@ -55,6 +55,13 @@ def format_simulate(
             )
         )
     return "\n".join(lines)
+
+
+def _simultaneous_text(traj: Trajectory) -> str:
+    """' (35 in simultaneous impacts resolved in the loop)': the reference's count of
+    simultaneous impacts its law resolved (RunStats.simultaneous_impacts), when any."""
+    n = traj.stats.get("simultaneous_impacts", 0) if traj.stats else 0
+    return f" ({n} simultaneous impacts resolved by the law in the loop)" if n else ""
 
 
 # Bidirectional-text overrides and isolates: invisible, but they reorder what follows.

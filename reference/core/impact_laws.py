@@ -8,7 +8,7 @@ caller applies (v, ω) += M⁻¹JᵀΛ.  They allocate nothing: the caller passe
 (`W`, `chol` at least k × k; `lam`, `u_post`, `vec` at least k long, `vec` 2k; `active`
 k integers).
 
-Laws (`LAW_*`; their names in `LAW_NAMES`):
+Laws (registered in reference.core.laws, which names them and gives their codes):
 
 - `paper`: the paper's rule: one single impact (eq. F) at a time; two contacts reached
   together, or a single impact that pushes a held contact, is undecidable (the run
@@ -52,20 +52,12 @@ import math
 
 from .impact import post_impact_velocity
 from .jit import hot
-from .law_codes import (  # noqa: F401  (the codes and limits, re-exported)
-    LAW_COMPLIANT,
-    LAW_COMPLIANT_MASS,
-    LAW_MOREAU,
-    LAW_NAMES,
-    LAW_PAPER,
-    LAW_SEQUENTIAL,
-    MAX_LAW_CONTACTS,
-    MAX_SEQUENTIAL_IMPACTS,
-    NOT_SETTLED,
-    SETTLED,
-    SINGULAR,
-    TOO_MANY,
-)
+
+# Outcomes of a law's solve
+SETTLED = 0
+NOT_SETTLED = 1  # sequential: MAX_SEQUENTIAL_IMPACTS reached; moreau: pivot cap
+SINGULAR = 2  # a contact whose W_ii is not positive (no impulse can move it)
+TOO_MANY = 3  # more than MAX_LAW_CONTACTS contacts
 
 # Tikhonov weight ε = REGULARISATION × max Wᵢᵢ: the regularised matrix has condition
 # ≤ 1e8, so its solve is good to ~1e-8 relative along W's near-null directions (the
@@ -75,12 +67,16 @@ REGULARISATION = 1e-8
 # two adjacent vertices of a 1000-gon, λ ≈ 4e-5 max Wᵢᵢ, converge by ~0.7 per pass)
 REFINE_REGULARISATION = 1e-4
 MAX_REFINE_PASSES = 400
+# the laws take at most this many contacts (Moreau's pivoting costs O(k⁴) at worst): a
+# larger polygon landing flat ends the run undecidable, saying so
+MAX_LAW_CONTACTS = 64
 # complementarity tolerance of the pivoting, relative to the largest |qᵢ| (roundoff)
 PIVOT_TOL = 64.0 * 2.220446049250313e-16
 # the sequential law has settled when no contact approaches faster than this × max|u⁻|:
 # below the loop's velocity roundoff (RATE_NOISE_ULPS ε V, V ≥ |u|), so that the loop
 # takes what is left for rest, not for a new impact an instant later
 SETTLE_REL = 16.0 * 2.220446049250313e-16
+MAX_SEQUENTIAL_IMPACTS = 100_000
 
 
 @hot
@@ -313,3 +309,18 @@ def sequential_impulses(W, u_pre, gamma, k, order, n_order, lam, u_post, max_hit
         u_post[j] = post_impact_velocity(u_j, gamma)  # exactly, as eq. F makes it
         hits += 1
     return NOT_SETTLED, hits
+
+
+@hot
+def moreau_law(W, u_pre, gamma, k, lam, u_post, work):
+    """Moreau's law in the registry's signature (reference.core.laws): one impact."""
+    status = moreau_impulses(W, u_pre, gamma, k, lam, u_post, work.chol, work.vec, work.active)
+    return status, 1
+
+
+@hot
+def sequential_law(W, u_pre, gamma, k, lam, u_post, work):
+    """The sequential law in the registry's signature (reference.core.laws)."""
+    return sequential_impulses(
+        W, u_pre, gamma, k, work.order, work.n_order, lam, u_post, work.max_hits
+    )
