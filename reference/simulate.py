@@ -20,8 +20,6 @@ import numpy as np
 from . import compiled
 from .checks import check_reference_options, run_horizon
 from .core import records as R
-from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
-from .core.law_event import NO_PROGRESS
 from .core.laws import LAW_PAPER, law_code, law_of, work_floats
 from .core.records import (
     N_ACCUMULATIONS,
@@ -172,6 +170,8 @@ def law_contacts(scene: Scene) -> int:
     to MAX_LAW_CONTACTS."""
     if law_code(scene.impact_law) == LAW_PAPER:
         return 1
+    from .core.impact_laws import MAX_LAW_CONTACTS  # here: the core's modules import numba
+
     return min(scene.contacts.n, MAX_LAW_CONTACTS)
 
 
@@ -345,6 +345,9 @@ _STATUS = {
 
 def _law_undecided(st, md, t, cs) -> str:
     """Why the run's impact law left a simultaneous impact undecided (law_event)."""
+    # here: the core's modules import numba (this runs only for such a run's message)
+    from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
+    from .core.law_event import NO_PROGRESS
     from .core.laws import LAWS
 
     law = next(x.name for x in LAWS if x.code == int(md["law"]))
