@@ -17,9 +17,9 @@ from .scene import (
     RunSettings,
     Scene,
     SceneError,
-    load_scene,
     scene_from_dict,
 )
+from .scenes import load_scene
 from .simulate import simulate
 from .stats import RunStats
 from .trajectory import ImpactEvent, Phase, Status, Trajectory

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .core.records import RIM_VERTEX_ON_PLANE
 from .geometry import energies
 
 if TYPE_CHECKING:
@@ -43,7 +44,8 @@ def contact_kind_names(scene: Scene) -> tuple[str, ...]:
     """The kind of each contact in the contact numbering, `rim` or `bump` (on every
     ground: `flat` has only rim vertices, `three_point` only bumps)."""
     contacts = scene.contacts
-    return (RIM,) * contacts.n_rim + (BUMP,) * (contacts.n - contacts.n_rim)
+    rim = contacts.of_kind(RIM_VERTEX_ON_PLANE)
+    return tuple(RIM if r else BUMP for r in rim)
 
 
 def resting_height(scene: Scene) -> float:

@@ -8,9 +8,11 @@ The kinds (reference.core.records; their geometry is reference.core.contacts):
 - FLOOR_POINT_ON_FACE: a fixed world point touching the body's face, normal e3 (engines:
   a sphere on the ground below a thin box on the body).
 
-A ground lists its rim vertices first (contacts 0 … n_rim − 1), then its floor points;
-`reference.scene.Ground.contacts` builds the list from a scene's [ground] table, and is
-the one place that reads `ground.kind`.
+Each contact's kind is stored with it (`GroundContacts.kinds`; the core's points carry
+it in a column, `core_points`), read by the core, the guard and the recordings alike.
+A ground lists its rim vertices first (contacts 0 … n_rim − 1, in order round the
+rim), then its floor points; `reference.scene.Ground.contacts` builds the list from a
+scene's [ground] table, and is the one place that reads `ground.kind`.
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ from .core.records import (
     FLOOR_POINT_ON_FACE,
     KEEPS_PLANE_MOMENTA,
     KEEPS_SPIN,
+    KIND_COLUMN,
+    POINT_COLUMNS,
     RIM_VERTEX_ON_PLANE,
 )
 
@@ -37,10 +41,30 @@ KIND_KEEPS = {RIM_VERTEX_ON_PLANE: KEEPS_PLANE_MOMENTA, FLOOR_POINT_ON_FACE: KEE
 @dataclass(frozen=True, eq=False)
 class GroundContacts:
     """The contacts of a ground: `points` (n, 3), read-only, rows 0 … n_rim − 1 the rim
-    vertices' body-frame points, the rest the floor points' world points."""
+    vertices' body-frame points, the rest the floor points' world points; `kinds` (n,)
+    each contact's kind."""
 
     points: np.ndarray
-    n_rim: int
+    kinds: np.ndarray
+
+    @property
+    def n_rim(self) -> int:
+        """How many rim vertices (they come first)."""
+        return int(np.count_nonzero(self.kinds == RIM_VERTEX_ON_PLANE))
+
+    @functools.cached_property
+    def core_points(self) -> np.ndarray:
+        """(n, POINT_COLUMNS) C-contiguous: the points and, in column KIND_COLUMN, the
+        kinds: what the compiled core reads (contacts.contact_kind)."""
+        out = np.zeros((self.n, POINT_COLUMNS))
+        out[:, :3] = self.points
+        out[:, KIND_COLUMN] = self.kinds
+        out.setflags(write=False)
+        return out
+
+    def of_kind(self, kind: int) -> np.ndarray:
+        """(n,) bool: which contacts are of `kind`."""
+        return self.kinds == kind
 
     @property
     def n(self) -> int:
@@ -59,22 +83,25 @@ class GroundContacts:
     @property
     def has_plane(self) -> bool:
         """Whether the ground has the plane z = 0 (its rim vertices touch it)."""
-        return self.n_rim > 0
+        return bool(np.any(self.of_kind(RIM_VERTEX_ON_PLANE)))
 
     @property
     def rim_only(self) -> bool:
         """Whether every contact is a rim vertex on the plane (then the circle through
         the vertices bounds every gap from below: z − a sin α)."""
-        return self.n_rim == self.n
+        return bool(np.all(self.of_kind(RIM_VERTEX_ON_PLANE)))
 
     def kind(self, k: int) -> int:
         """The kind of contact k (`reference.core.contacts.contact_kind`)."""
-        return RIM_VERTEX_ON_PLANE if k < self.n_rim else FLOOR_POINT_ON_FACE
+        return int(self.kinds[k])
 
     def label(self, k: int) -> str:
-        """'v2' (rim vertex 2) or 'b1' (floor point 1: numbered among the floor points)."""
+        """'v2' (rim vertex 2) or 'b1' (floor point 1: numbered among the contacts of its
+        kind); '#k' for a number that is no contact of this ground."""
+        if not 0 <= k < self.n:
+            return f"#{k}"
         kind = self.kind(k)
-        return f"{KIND_LABEL[kind]}{k if kind == RIM_VERTEX_ON_PLANE else k - self.n_rim}"
+        return f"{KIND_LABEL[kind]}{int(np.count_nonzero(self.kinds[:k] == kind))}"
 
     def lever(self, k: int) -> float:
         """Contact k's distance from the symmetry axis when the body lies flat on the
@@ -85,10 +112,8 @@ class GroundContacts:
     def invariants(self) -> int:
         """The records.KEEPS_* bits every contact force keeps (inertia.excess_energy)."""
         keeps = KEEPS_PLANE_MOMENTA | KEEPS_SPIN
-        if self.n_rim:
-            keeps &= KIND_KEEPS[RIM_VERTEX_ON_PLANE]
-        if self.n > self.n_rim:
-            keeps &= KIND_KEEPS[FLOOR_POINT_ON_FACE]
+        for kind in set(self.kinds.tolist()):
+            keeps &= KIND_KEEPS[kind]
         return keeps
 
     @property
@@ -106,7 +131,15 @@ def ground_contacts(n_rim: int, radius: float, n_floor: int, floor_radius: float
     parts = [_regular_points(n_rim, radius), _regular_points(n_floor, floor_radius)]
     pts = np.concatenate(parts) if n_rim and n_floor else parts[0] if n_rim else parts[1]
     pts.setflags(write=False)
-    return GroundContacts(pts, n_rim)
+    return GroundContacts(pts, _kinds(n_rim, n_floor))
+
+
+def _kinds(n_rim: int, n_floor: int) -> np.ndarray:
+    """(n_rim + n_floor,) read-only: n_rim rim vertices, then n_floor floor points."""
+    kinds = np.array([RIM_VERTEX_ON_PLANE] * n_rim + [FLOOR_POINT_ON_FACE] * n_floor)
+    kinds = kinds.astype(np.int64)
+    kinds.setflags(write=False)
+    return kinds
 
 
 @functools.lru_cache(maxsize=64)
@@ -119,7 +152,7 @@ def listed_contacts(
         [_regular_points(n_rim, radius), np.asarray(floor_points, dtype=float).reshape(-1, 3)]
     )
     pts.setflags(write=False)
-    return GroundContacts(pts, n_rim)
+    return GroundContacts(pts, _kinds(n_rim, len(pts) - n_rim))
 
 
 def _regular_points(k: int, r: float) -> np.ndarray:

@@ -57,9 +57,9 @@ def contact_kinematics(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Gap and normal velocity (N, k) of every contact of a ground for states (N, 13)."""
     S = _states(states)
-    pts = np.ascontiguousarray(contacts.points, dtype=float)
+    pts = contacts.core_points
     gap, vn = np.empty((len(S), len(pts))), np.empty((len(S), len(pts)))
-    function("contact_kinematics_rows")(S, pts, contacts.n_rim, gap, vn)
+    function("contact_kinematics_rows")(S, pts, gap, vn)
     return gap, vn
 
 

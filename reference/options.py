@@ -26,10 +26,10 @@ class ReferenceOptions:
       SIGTERM); 50,000 steps take at most about 0.6 s (the costliest steps measured, a
       100-gon held on bumps, 12 µs each on a loaded 2-core machine), and the results do
       not depend on it.
-    impact_law: how several contacts touching at an impact are resolved: `paper` (the
-      paper's rule: the run ends `simultaneous_impact`), `moreau` or `sequential`
-      (reference.core.impact_laws; docs/architecture.md, "Impact laws"); None: the
-      scene's `impact_law` (default `paper`).
+    impact_law: how several contacts touching at an impact are resolved: a name of the
+      law registry (reference.core.laws.LAW_NAMES: `paper`, the paper's rule, ends the
+      run `simultaneous_impact`; `moreau`, `sequential`, ...; docs/architecture.md,
+      "Impact laws"); None: the scene's `impact_law` (default `paper`).
     simultaneity_window: contacts reaching the ground within this time T of each other
       count as one simultaneous impact (T |u|/√(g a) after a contact reached at normal
       speed |u|: scene.window_speed_unit); None: the scene's, else the law's

@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from .contact_kinds import GroundContacts, ground_contacts, listed_contacts
+from .core.laws import DEFAULT_LAW, LAW_NAMES, LAW_PAPER, law_code
 from .core.layout import QUATERNION
 from .geometry import initial_state, scene_contact_kinematics
 from .quaternion import body_axis
@@ -74,9 +75,9 @@ DEFAULT_FLOOR_DEPTH = 0.1
 MAX_SPEED = 1e3
 MAX_POSITION = 1e6
 MAX_ROTATION_VECTOR = 1e3
-# the impact laws of simultaneous impacts (reference.core.impact_laws.LAW_NAMES)
-IMPACT_LAWS = ("paper", "moreau", "sequential", "compliant", "compliant-mass")
-DEFAULT_IMPACT_LAW = "paper"
+# the impact laws of simultaneous impacts: the registry's (reference.core.laws)
+IMPACT_LAWS = LAW_NAMES
+DEFAULT_IMPACT_LAW = DEFAULT_LAW
 # the exact reference's simultaneity window [time unit of the scene] under `moreau` and
 # `sequential` when neither the scene nor the options set one (under `paper`: 0,
 # default_window): contacts whose zeros are this close (× |u|/√(g a)) are reached
@@ -276,14 +277,6 @@ MAX_BUMPS = 64
 _INITIAL_LINEAR = {"q", "p", "scale"}
 _INITIAL_FULL = {"position", "rotation_vector", "velocity", "angular_velocity"}
 _RUN_KEYS = {"t_end", "max_impacts"}
-
-
-def load_scene(path_or_name: str | Path) -> Scene:
-    """A scene from a file or the name of a built-in scene (reference.scenes:
-    "pentagon-bounce"), validated."""
-    from .scenes import resolve_scene
-
-    return resolve_scene(path_or_name)
 
 
 def load_scene_file(path: str | Path) -> Scene:
@@ -673,7 +666,7 @@ def default_window(law: str) -> float:
     and its results as they are: a window there ends more runs `simultaneous_impact`,
     measured in docs/laws.md), DEFAULT_SIMULTANEITY_WINDOW under the laws that
     resolve a simultaneous impact."""
-    return 0.0 if law == "paper" else DEFAULT_SIMULTANEITY_WINDOW
+    return 0.0 if law_code(law) == LAW_PAPER else DEFAULT_SIMULTANEITY_WINDOW
 
 
 def window_speed_unit(scene: Scene) -> float:

@@ -17,9 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import compiled, continuation
+from . import compiled
 from .checks import check_reference_options, run_horizon
 from .core import records as R
+from .core.laws import LAW_PAPER, law_code, law_of, work_floats
 from .core.records import (
     N_ACCUMULATIONS,
     N_IMPACTS,
@@ -30,7 +31,7 @@ from .core.records import (
     RETURN_GROW,
 )
 from .core.tolerances import MAX_STALL_STEPS, TILT_FLOOR
-from .geometry import contact_points, initial_state
+from .geometry import initial_state
 from .options import ReferenceOptions
 from .scene import (
     Scene,
@@ -70,7 +71,7 @@ class Problem:
     """The records and arrays one run of the loop reads and writes."""
 
     run: np.ndarray  # records.RUN, 1 element: model, options, state, counters, scratch
-    points: np.ndarray  # (k, 3) contact points
+    points: np.ndarray  # (k, 4) contact points and kinds (GroundContacts.core_points)
     sample_t: np.ndarray
     sample_y: np.ndarray
     sample_e: np.ndarray
@@ -79,6 +80,7 @@ class Problem:
     accumulations: np.ndarray
     contact_ints: np.ndarray  # (4, k) and (4, k): the loop's per-contact lists
     contact_floats: np.ndarray  # (records.new_contact_arrays)
+    law_arrays: tuple  # the scratch of a law impact (records.new_law_arrays)
     full_rows: dict[str, int]  # output_rows for max_impacts: the first growth's sizes
     _arguments: tuple | None = None  # (kept until the arrays grow)
 
@@ -95,25 +97,28 @@ class Problem:
             self._arguments = (
                 self.run, self.points, self.sample_t, self.sample_y, self.sample_e,
                 self.impacts, self.phases, self.accumulations, self.contact_ints,
-                self.contact_floats,
+                self.contact_floats, *self.law_arrays,
             )  # fmt: skip
         return self._arguments
 
     def grow(self, max_samples: int) -> None:
         """Grow the arrays the loop ran short of (to their full_rows, or twice their
-        rows if that is more): impacts, phases and accumulation times with fewer than
-        STEP_ROWS free rows (the loop's own test before every step); otherwise the
+        rows if that is more): impacts with fewer than options.step_rows free rows,
+        phases and accumulation times with fewer than STEP_ROWS (the loop's own test
+        before every step); otherwise the
         samples (the only rows a step itself asks for), up to max_samples rows.  Growing
         the large sample arrays only when they are what is short keeps runs with many
         chatter completions from copying them again and again."""
         self._arguments = None
         c = self.counts
         short = False
-        for name, col in (("impacts", N_IMPACTS), ("phases", N_PHASES),
-                          ("accumulations", N_ACCUMULATIONS)):  # fmt: skip
+        step_rows = int(self.options["step_rows"][0])
+        for name, col, need in (("impacts", N_IMPACTS, step_rows),
+                                ("phases", N_PHASES, R.STEP_ROWS),
+                                ("accumulations", N_ACCUMULATIONS, R.STEP_ROWS)):  # fmt: skip
             arr = getattr(self, name)
-            if len(arr) - c[col] < R.STEP_ROWS:
-                rows = max(2 * len(arr), self.full_rows.get(name, 0))
+            if len(arr) - c[col] < need:
+                rows = max(2 * len(arr), self.full_rows.get(name, 0), c[col] + need)
                 setattr(self, name, _grown(arr, rows))
                 short = True
         rows = min(max(2 * len(self.sample_t), self.full_rows["samples"]), max(max_samples, 1))
@@ -147,7 +152,27 @@ def model_record(scene: Scene) -> np.ndarray:
     rec["all_down"] = contacts.all_down
     rec["window_per_speed"] = reference_window(scene) / window_speed_unit(scene)
     rec["floor_depth"] = scene.ground.floor_below(scene.body)
+    rec["law"] = law_code(scene.impact_law)
+    rec["law_separating"] = law_of(rec["law"][0]).separating
     return rec
+
+
+def law_arrays(scene: Scene, opts: ReferenceOptions) -> tuple:
+    """The scratch of a simultaneous impact under the scene's law (records.new_law_arrays)."""
+    k = law_contacts(scene)
+    work = work_floats(law_of(law_code(scene.impact_law)), k)
+    return R.new_law_arrays(k, opts.sequential_order or (), work)
+
+
+def law_contacts(scene: Scene) -> int:
+    """How many contacts a simultaneous impact of the scene's law may take at most (the
+    rows of its scratch): none under `paper` (a row of scratch), else all of them up
+    to MAX_LAW_CONTACTS."""
+    if law_code(scene.impact_law) == LAW_PAPER:
+        return 1
+    from .core.impact_laws import MAX_LAW_CONTACTS  # here: the core's modules import numba
+
+    return min(scene.contacts.n, MAX_LAW_CONTACTS)
 
 
 def options_record(scene: Scene, t_end: float, opts: ReferenceOptions) -> np.ndarray:
@@ -161,6 +186,9 @@ def options_record(scene: Scene, t_end: float, opts: ReferenceOptions) -> np.nda
     rec["max_impacts"] = scene.run.max_impacts
     rec["window_search"] = opts.window_search
     rec["work_budget"] = opts.work_budget
+    rec["n_order"] = len(opts.sequential_order or ())
+    paper = law_code(scene.impact_law) == LAW_PAPER
+    rec["step_rows"] = R.STEP_ROWS + (0 if paper else law_contacts(scene))
     return rec
 
 
@@ -175,7 +203,7 @@ def initial_record(y0: np.ndarray) -> np.ndarray:
 
 def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
     rows = output_rows(min(scene.run.max_impacts, FIRST_IMPACTS), t_end, opts)
-    points = np.array(contact_points(scene.body, scene.ground), dtype=float, order="C")
+    points = np.array(scene.contacts.core_points)  # (the loop's own, writable copy)
     contact_ints, contact_floats = R.new_contact_arrays(len(points))
     run = np.zeros(1, dtype=R.RUN)
     run["model"] = model_record(scene)
@@ -192,6 +220,7 @@ def make_problem(scene: Scene, t_end: float, opts: ReferenceOptions) -> Problem:
         accumulations=np.empty(MIN_ROWS),
         contact_ints=contact_ints,
         contact_floats=contact_floats,
+        law_arrays=law_arrays(scene, opts),
         full_rows=output_rows(scene.run.max_impacts, t_end, opts),
     )
 
@@ -238,18 +267,9 @@ def simulate(
     kernel = compiled.run_events()
     t0 = time.perf_counter()
     run_problem(kernel, problem, opts.max_samples, progress)
-    note = None
-    if law != "paper" and continuation.undecidable(problem.state[0]):
-        note = continuation.continue_run(
-            scene, problem, kernel, law, opts.sequential_order, opts.energy_floor,
-            lambda k, p: run_problem(k, p, opts.max_samples, progress), opts.chatter_tol,
-        )  # fmt: skip
-        problem.options["energy_floor"] = opts.energy_floor  # (restarts rescale it)
     wall = time.perf_counter() - t0
     traj = _trajectory(scene, problem, opts, t_end, wall, compile_s)
     traj.impact_law, traj.simultaneity_window = law, window
-    if note is not None:
-        traj.message = note
     return traj
 
 
@@ -318,11 +338,34 @@ _STATUS = {
     R.STATUS_MAX_IMPACTS: Status.MAX_IMPACTS,
     R.STATUS_OFF_FACE: Status.LEFT_MODEL,
     R.STATUS_BELOW_FLOOR: Status.LEFT_MODEL,
+    R.STATUS_LAW_UNDECIDED: Status.SIMULTANEOUS_IMPACT,
+    R.STATUS_FLAT_REST: Status.SINGULARITY,
 }
 
 
-# One-sentence messages per loop status: (state, options, model, t, sorted info
-# contacts) → text, formatted only for the status a run ends with.
+def _law_undecided(st, md, t, cs) -> str:
+    """Why the run's impact law left a simultaneous impact undecided (law_event)."""
+    # here: the core's modules import numba (this runs only for such a run's message)
+    from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
+    from .core.law_event import NO_PROGRESS
+    from .core.laws import LAWS
+
+    law = next(x.name for x in LAWS if x.code == int(md["law"]))
+    outcome = int(st["law_outcome"])
+    if outcome == NOT_SETTLED:
+        return (f"the {law} law did not settle after {MAX_SEQUENTIAL_IMPACTS} single "
+                f"impacts at t = {t:.17g} (contacts {cs}): undecidable")  # fmt: skip
+    if outcome == SINGULAR:
+        return f"a contact of {cs} takes no impulse at t = {t:.17g}"
+    if outcome == NO_PROGRESS:
+        return f"the {law} law made no progress at t = {t:.17g}: stopped (undecidable)"
+    return (f"contacts touch at t = {t:.17g} beyond the {MAX_LAW_CONTACTS} the impact "
+            "laws take (undecidable)")  # fmt: skip
+
+
+# One-sentence messages per loop status: (state, options, model, t, the info contacts'
+# names) → text, formatted only for the status a run ends with.  Contacts are named as in
+# every table (v2: rim vertex 2, b1: bump 1; GroundContacts.label).
 _MESSAGES = {
     R.STATUS_T_END: lambda st, op, md, t, cs: f"reached t_end = {float(op['t_end']):g}",
     R.STATUS_SINGULARITY: lambda st, op, md, t, cs: f"all contacts down at t = {t:.17g}",
@@ -335,21 +378,19 @@ _MESSAGES = {
         "double precision; t_singularity extrapolated from the impact intervals"
     ),
     R.STATUS_AT_REST: lambda st, op, md, t, cs: (
-        f"at rest on contacts {cs} at t = {t:.17g}: the motion has ended"
+        f"at rest on {cs} at t = {t:.17g}: the motion has ended"
     ),
-    R.STATUS_SIMULTANEOUS: lambda st, op, md, t, cs: (
-        f"contacts {cs} hit simultaneously at t = {t:.17g}"
-    ),
+    R.STATUS_SIMULTANEOUS: lambda st, op, md, t, cs: f"{cs} hit simultaneously at t = {t:.17g}",
     R.STATUS_PUSHED: lambda st, op, md, t, cs: (
-        f"impact at contact {int(st['info_contact'])} at t = {t:.17g} would push "
-        f"resting contact(s) {cs} into the ground (undecidable)"
+        f"an impact at {md['label'](int(st['info_contact']))} at t = {t:.17g} would push "
+        f"{cs}, resting, into the ground (undecidable)"
     ),
     R.STATUS_MAX_IMPACTS: lambda st, op, md, t, cs: (
         f"reached max_impacts = {int(op['max_impacts'])}"
     ),
     R.STATUS_FAILED_NONFINITE: lambda st, op, md, t, cs: f"non-finite state at t = {t:.17g}",
     R.STATUS_OFF_FACE: lambda st, op, md, t, cs: (
-        f"bump {cs[0] if cs else -1} meets the face's plane outside its rim "
+        f"{cs or 'a bump'} meets the face's plane outside its rim "
         f"at t = {t:.17g}: the body has left the bumps (outside the three_point model)"
     ),
     R.STATUS_BELOW_FLOOR: lambda st, op, md, t, cs: (
@@ -357,8 +398,13 @@ _MESSAGES = {
         f"below the bumps' tops) at t = {t:.17g}, which the three_point ground does not "
         "model: the body has left the model"
     ),
+    R.STATUS_LAW_UNDECIDED: lambda st, op, md, t, cs: _law_undecided(st, md, t, cs),
+    R.STATUS_FLAT_REST: lambda st, op, md, t, cs: (
+        f"flat bounces from t = {t:.17g} completed in closed form (t_f = t + 2u/(g(1 - "
+        f"gamma))): at rest on all contacts at t = {float(st['t_hi']):.17g}"
+    ),
     R.STATUS_FAILED_LCP: lambda st, op, md, t, cs: (
-        f"contact complementarity problem of contacts {cs} has no solution (at t = {t:.17g})"
+        f"contact complementarity problem of {cs} has no solution (at t = {t:.17g})"
     ),
     R.STATUS_FAILED_STUCK: lambda st, op, md, t, cs: (
         f"event search did not converge (at t = {t:.17g})"
@@ -368,21 +414,27 @@ _MESSAGES = {
     ),
     R.STATUS_FAILED_NO_ADVANCE: lambda st, op, md, t, cs: (
         f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, or "
-        f"{MAX_STALL_STEPS} steps without progress, with contacts {cs} held)"
+        f"{MAX_STALL_STEPS} steps without progress, with {cs} held)"
     ),
 }
 
 
-def status_message(state: np.void, opts: np.void, model: np.void) -> tuple[Status, str]:
+def status_message(
+    state: np.void, opts: np.void, model: np.void, label: Callable[[int], str] | None = None
+) -> tuple[Status, str]:
     """The Trajectory status and its one-sentence message for the loop's end state (the
-    run's options and model records)."""
+    run's options and model records; `label` names contact k, 'contact k' without it)."""
     code = int(state["status"])
     message = _MESSAGES.get(code)
     if message is None:
         return _STATUS.get(code, Status.FAILED), f"loop status {code}"
-    contacts = sorted(int(c) for c in state["info"][: int(state["n_info"])])
+    name = label or (lambda k: f"contact {k}")
+    contacts = ", ".join(
+        name(k) for k in sorted(int(c) for c in state["info"][: int(state["n_info"])])
+    )
     t = float(state["info_t"])
-    return _STATUS.get(code, Status.FAILED), message(state, opts, model, t, contacts)
+    fields = {field: model[field] for field in model.dtype.names} | {"label": name}
+    return _STATUS.get(code, Status.FAILED), message(state, opts, fields, t, contacts)
 
 
 def _trajectory(
@@ -396,7 +448,7 @@ def _trajectory(
         )
     ns, ni, nph, nacc = (int(c[i]) for i in (N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS))
     state = p.state[0]
-    status, message = status_message(state, p.options[0], p.model[0])
+    status, message = status_message(state, p.options[0], p.model[0], scene.contacts.label)
     t_sing = float(state["t_singularity"])
     stats = RunStats.from_counters(
         p.counters[0],

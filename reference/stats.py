@@ -18,7 +18,9 @@ class RunStats(Mapping):
 
     wall_time_s: the run itself, without one-time compilation or loading (compile_s);
     impacts_per_s = n_impacts / wall_time_s; search_iterations_per_impact: event-search
-    steps per impact (the cost of the conservative advancement)."""
+    steps per impact (the cost of the conservative advancement); simultaneous_impacts:
+    the simultaneous impacts the run's impact law resolved inside the compiled loop (0
+    under `paper`, whose rule ends the run there)."""
 
     wall_time_s: float
     compile_s: float
@@ -39,6 +41,7 @@ class RunStats(Mapping):
     contact_energy_drift_max: float
     max_penetration: float
     loop_steps: int
+    simultaneous_impacts: int
     samples: int
 
     @classmethod

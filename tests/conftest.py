@@ -58,10 +58,9 @@ def scene_factory():
 
 def core_model(scene: Scene):
     """(model record, contact points) of a scene, as the compiled core reads them."""
-    from reference.geometry import contact_points
     from reference.simulate import model_record
 
-    return model_record(scene)[0], np.array(contact_points(scene.body, scene.ground), order="C")
+    return model_record(scene)[0], np.array(scene.contacts.core_points, order="C")
 
 
 def flight(scene: Scene, y0: np.ndarray, s: float) -> np.ndarray:

@@ -90,6 +90,7 @@ def test_the_linear_loop_returns_to_python_every_budget_of_events(scene, monkeyp
 
     import reference.linear.simulate as ls
     from reference.linear import kernel as K
+    from reference.linear import segment
     from reference.linear.model import LinearModel, linear_state
 
     model = LinearModel.from_scene(scene)
@@ -102,7 +103,7 @@ def test_the_linear_loop_returns_to_python_every_budget_of_events(scene, monkeyp
         calls.append(args[-1])
         return real(*args)
 
-    monkeypatch.setattr(ls, "LOOP_BUDGET", 10)
+    monkeypatch.setattr(segment, "LOOP_BUDGET", 10)
     monkeypatch.setattr(K, "continue_kernel", counted)
     sliced = ls.run_linear(model, q0, p0, t_end=3.0)
     assert len(whole.kind) > 50 and len(calls) >= len(whole.kind) // 10

@@ -1,7 +1,8 @@
 """Runs of the exact reference under the impact laws of simultaneous impacts
-(reference.continuation): scenes that start on 2, 3 and 6 contacts against the
-enumerated LCP (tests/oracle/lcp.py), the flat drop's bounces completed in closed form,
-the law named in every output, and the scene key and options."""
+(reference.core.law_event, inside the compiled loop): scenes that start on 2, 3 and 6
+contacts against the enumerated LCP (tests/oracle/lcp.py), the flat drop's bounces
+listed and completed in closed form, the law named in every output, and the scene key
+and options."""
 
 from __future__ import annotations
 
@@ -85,14 +86,50 @@ def test_a_flat_drop_bounces_flat_and_rests_at_the_accumulation_time(gamma):
     t_f = t1 + 2 * gamma * v1 / (g * (1 - gamma))
     assert traj.status.value == "singularity"
     assert traj.t_singularity == pytest.approx(t_f, rel=1e-12)
-    assert len(traj.impacts) == n
-    for e in traj.impacts:
+    first = [e for e in traj.impacts if e.t == traj.impacts[0].t]
+    assert len(first) == n
+    for e in first:
         assert e.t == pytest.approx(t1, rel=1e-12)
         assert e.impulse == pytest.approx((1 + gamma) * v1 / n, rel=1e-10)
     assert traj.position[-1][0] == pytest.approx(vx * t_f, rel=1e-12)
     assert abs(traj.velocity[-1][2]) < 1e-15 and traj.kinetic_energy[-1] == pytest.approx(
         0.5 * vx**2 + 0.5 * scene.body.inertia_diag[2] * 0.2**2, rel=1e-12
     )
+
+
+def test_a_flat_drop_lists_its_bounces_then_completes_them_in_closed_form():
+    """Dropped flat from h = a/2 with γ = 1/2 (g = a = 1): landing k comes at
+    t_k = t1 + Σⱼ₌₁..ₖ 2γʲv1/g, every vertex hit with the body's vertical speed γᵏv1,
+    while the bounces are above the completion speed; the rest of the series ends at
+    rest at t_f = t1 + 2γv1/(g(1 − γ)), an accumulation time."""
+    h, g, gamma, n = 0.5, 1.0, 0.5, 3
+    scene = scene_from_dict(
+        {
+            "gravity": g, "restitution": gamma, "impact_law": "moreau", "body": {"n": n},
+            "initial": {"position": [0, 0, h], "rotation_vector": [0, 0, 0.3],
+                        "velocity": [0, 0, 0], "angular_velocity": [0, 0, 0]},
+            "run": {"t_end": 10.0},
+        }
+    )  # fmt: skip
+    traj = simulate(scene)
+    t1 = math.sqrt(2 * h / g)
+    v1 = g * t1
+    landings = sorted({e.t for e in traj.impacts})
+    assert len(landings) >= 5
+    assert len(traj.impacts) == n * len(landings)
+    t_k = t1
+    for k, t in enumerate(landings):
+        assert t == pytest.approx(t_k, rel=1e-14, abs=0)
+        rows = [e for e in traj.impacts if e.t == t]
+        assert sorted(e.contact for e in rows) == list(range(n))
+        for e in rows:
+            assert e.v_normal_pre == pytest.approx(-(gamma**k) * v1, rel=1e-9)
+        t_k += 2 * gamma ** (k + 1) * v1 / g
+    t_f = t1 + 2 * gamma * v1 / (g * (1 - gamma))
+    assert traj.status.value == "singularity"
+    assert traj.t_singularity == pytest.approx(t_f, rel=1e-12, abs=0)
+    assert traj.stats.chatter_accumulation_times[-1] == traj.t_singularity
+    assert traj.stats.simultaneous_impacts == len(landings)
 
 
 def test_the_sequential_law_resolves_a_flat_landing_without_gaining_energy():
@@ -130,7 +167,12 @@ def test_every_output_names_the_law(tmp_path, capsys):
         DEFAULT_SIMULTANEITY_WINDOW,
     )
     assert doc["status"] == "singularity" and doc["t_singularity"] == pytest.approx(3.0)
-    assert len({r["t"] for r in doc["impacts"]}) == 1 and len(doc["impacts"]) == 6
+    landings = {r["t"] for r in doc["impacts"]}
+    assert min(landings) == 1.0 and len(doc["impacts"]) == 6 * len(landings)
+    assert doc["stats"]["simultaneous_impacts"] == len(landings)
+    assert main(["simulate", str(path), "--impact-law", "moreau"]) == 0
+    text = capsys.readouterr().out
+    assert f"impacts     {6 * len(landings)} ({len(landings)} simultaneous impacts" in text
     assert main(["simulate", str(path)]) == 0
     assert "impact law  paper (simultaneity window 0)" in capsys.readouterr().out
     assert main(["simulate", str(path), "--simultaneity-window", "-1"]) == 2
@@ -189,7 +231,7 @@ def test_the_built_in_near_simultaneous_hits_are_one_impact_under_the_default_wi
         scene, options=ReferenceOptions(simultaneity_window=DEFAULT_SIMULTANEITY_WINDOW)
     )
     assert traj.status.value == "simultaneous_impact"
-    assert "[0, 1]" in traj.message and traj.impacts == []
+    assert "v0, v1 hit simultaneously" in traj.message and traj.impacts == []
 
 
 @pytest.mark.parametrize("sample", [0, 1, 2, 3])

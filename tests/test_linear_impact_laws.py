@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from reference.core.impact_laws import LAW_MOREAU, LAW_NAMES, LAW_SEQUENTIAL, SETTLED
+from reference.core.impact_laws import SETTLED
+from reference.core.laws import LAW_NAMES, law_code
 from reference.linear import kernel as K
 from reference.linear.laws import apply_law, delassus
 from reference.linear.model import LinearModel, full_states
@@ -14,6 +15,7 @@ from reference.scene import scene_from_dict
 from reference.trajectory import Status
 from tests.oracle.quaternion import to_matrix as oracle_rotation
 
+LAW_MOREAU, LAW_SEQUENTIAL = law_code("moreau"), law_code("sequential")
 LAWS = (LAW_MOREAU, LAW_SEQUENTIAL)
 
 
@@ -82,7 +84,7 @@ def test_the_core_forms_the_same_delassus_matrix_the_test_derives():
     W, chol = np.zeros((k, k)), np.zeros((k, k))
     u_pre, lam, u_post, vec = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(2 * k)
     active, result = np.zeros(k, dtype=np.int64), np.zeros(3, dtype=np.int64)
-    pts = np.ascontiguousarray(scene.contacts.points, dtype=float)
+    pts = np.ascontiguousarray(scene.contacts.core_points, dtype=float)
     function("multi_impact")(
         y.copy(), model_record(scene), pts, LAW_MOREAU, cs, k, np.zeros(0, dtype=np.int64), 0,
         10, 1e-6, W, u_pre, lam, u_post, chol, vec, active, result,

@@ -88,6 +88,8 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
         "MAX_IMPACTS": Status.MAX_IMPACTS,
         "OFF_FACE": Status.LEFT_MODEL,
         "BELOW_FLOOR": Status.LEFT_MODEL,
+        "LAW_UNDECIDED": Status.SIMULTANEOUS_IMPACT,
+        "FLAT_REST": Status.SINGULARITY,
         "FAILED_NONFINITE": Status.FAILED,
         "FAILED_LCP": Status.FAILED,
         "FAILED_STUCK": Status.FAILED,
@@ -114,6 +116,14 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
         messages.add(message)
     assert len(messages) == len(codes)
     state["status"] = R.STATUS_SIMULTANEOUS
-    assert status_message(state, opts, model)[1] == "contacts [2] hit simultaneously at t = 0.125"
+    assert status_message(state, opts, model)[1] == "contact 2 hit simultaneously at t = 0.125"
+    text = status_message(state, opts, model, label=lambda k: f"v{k}")[1]
+    assert text == "v2 hit simultaneously at t = 0.125"
+    state["status"] = R.STATUS_LAW_UNDECIDED  # one sentence per way a law leaves it
+    said = set()
+    for outcome in range(1, 5):  # NOT_SETTLED, SINGULAR, TOO_MANY, law_event.NO_PROGRESS
+        state["law_outcome"] = outcome
+        said.add(status_message(state, opts, model)[1])
+    assert len(said) == 4
     state["status"] = 999
     assert status_message(state, opts, model) == (Status.FAILED, "loop status 999")

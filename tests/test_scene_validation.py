@@ -7,7 +7,8 @@ import math
 import pytest
 
 from harness.scenes import builtin_names, resolve_scene
-from reference.scene import SceneError, load_scene, scene_from_dict
+from reference.scene import SceneError, scene_from_dict
+from reference.scenes import load_scene
 
 GOOD = {
     "name": "s",

@@ -77,6 +77,14 @@ time       median wall time of one run [s] (--wide: and the fastest)
 (docs/output.md defines every column; --wide: every column, --json: every number)"""
 
 
+# the summary's metrics in words (the JSON keeps the keys)
+METRIC_NAMES = {
+    "energy_error_agreeing": "energy error while the run follows the reference (E_err<div)",
+    "energy_error": "energy error over the common window (E_err)",
+    "impact_time_error": "impact time error [s] (t_err)",
+}
+
+
 def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
     """Per metric, each simulator's best error among the runs that follow the
     reference, its cost, and the cost ratio to the reference at that accuracy."""
@@ -85,7 +93,7 @@ def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
     lines = [
         "summary (runs that follow the reference only): best error, its cost, and that cost "
         "over the",
-        "reference's cost at the same accuracy ('>=': a lower bound, '<=': an upper bound)",
+        "reference's cost at the same accuracy (≥: a lower bound, ≤: an upper bound)",
     ]
     for metric, per in derived.items():
         rows = []
@@ -94,16 +102,13 @@ def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
             if d is None:
                 rows.append([engine, "-", "-", "no run follows the reference"])
                 continue
-            bound = {"lower": ">=", "upper": "<="}.get(d["cost_ratio_bound"], "")
+            bound = {"lower": "≥ ", "upper": "≤ "}.get(d["cost_ratio_bound"], "")
             ratio = _fmt(d["cost_ratio"], ".3g")
             rows.append(
-                [engine, _fmt(d["best_error"]), f"{d['best_error_cost_s']:.3g}", f"{bound}{ratio}x"]
+                [engine, _fmt(d["best_error"]), f"{d['best_error_cost_s']:.3g}", f"{bound}{ratio}"]
             )
-        lines += [
-            "",
-            f"{metric}:",
-            table(rows, ["simulator", "best", "cost[s]", "x reference"], align="lrrl"),
-        ]
+        header = ["simulator", "best error", "its cost [s]", "cost / reference's"]
+        lines += ["", f"{METRIC_NAMES.get(metric, metric)}:", table(rows, header, align="lrrl")]
     return lines
 
 

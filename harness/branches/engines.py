@@ -129,13 +129,14 @@ def distance(scene, y, y_ref, contacts: list[int]) -> float:
 def undecidable_state(scene, t_end: float):
     """(paper trajectory, t_u, y_u, touching contacts) or (traj, None, None, [])."""
     from reference import simulate
-    from reference.continuation import touching_contacts
+
+    from .spread import touching_contacts
 
     paper = simulate(scene.with_impact_law("paper"), t_end=t_end)
     if paper.status.value != "simultaneous_impact":
         return paper, None, None, []
     y_u = state_of(paper)
-    touching = touching_contacts(scene, y_u, [], separating=True)
+    touching = touching_contacts(scene, y_u, separating=True)
     return paper, float(paper.t_final), y_u, touching.tolist()
 
 

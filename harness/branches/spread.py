@@ -2,9 +2,9 @@
 
 The reference runs the scene under the paper's rule; where it stops
 `simultaneous_impact` (at t_u, contacts C touching) each branch runs the same scene
-under another impact law: `moreau`, `sequential` (the fastest approach first),
-`compliant`, `compliant-mass` and, when
-at most three contacts touch, `sequential` in every order of C.  Up to t_u every branch
+under another impact law: every law of the registry that resolves a simultaneous impact
+(reference.core.laws: `moreau`, `sequential` with the fastest approach first, ...) and,
+when at most three contacts touch, `sequential` in every order of C.  Up to t_u every branch
 is the same exact run (the same compiled loop); after it they differ only by the law.
 The contacts of the impact are those touching at t_u and those the laws gave impulses
 there.
@@ -20,12 +20,18 @@ from typing import Any
 
 import numpy as np
 
+from reference.core.laws import resolving_laws
+from reference.core.tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS
+from reference.geometry import contact_kinematics
 from reference.trajectory import Trajectory
 
 # impacts after t_u listed per branch
 NEXT_IMPACTS = 4
 # orders of the sequential law are tried for at most this many touching contacts
 MAX_ORDERED_CONTACTS = 3
+# touching: gap within this many roundoff bands of the ground (the loop reaches a
+# contact to a few ulps of |z| + a)
+TOUCH_ULPS = 4 * GAP_NOISE_ULPS
 
 
 @dataclass
@@ -96,6 +102,20 @@ def spread_of(branches: list[Branch]) -> dict[str, Any]:
     }
 
 
+def touching_contacts(scene, y: np.ndarray, separating: bool = False) -> np.ndarray:
+    """Contacts touching the ground at state y and not separating: gap ≤ TOUCH_ULPS ε
+    (|z| + a), normal velocity ≤ its roundoff (the rule of the loop's simultaneous
+    impacts, reference.core.law_event); `separating`: the touching ones that separate
+    too (the laws that take them, `ImpactLaw.separating`)."""
+    gap, vn = contact_kinematics(y, scene.contacts)
+    gap, vn = gap[0], vn[0]
+    a = scene.body.radius
+    gap_tol = TOUCH_ULPS * EPS * (abs(y[2]) + a)
+    v_scale = np.linalg.norm(y[7:10]) + a * np.linalg.norm(y[10:13])
+    at_rest = vn <= RATE_NOISE_ULPS * EPS * v_scale
+    return np.flatnonzero((gap <= gap_tol) & (at_rest | separating))
+
+
 def ordered_runs(contacts: list[int]) -> list[tuple[str, str, tuple[int, ...]]]:
     """(name, law, order) of the sequential law in every order of the contacts (when at
     most MAX_ORDERED_CONTACTS of them, more than one)."""
@@ -156,8 +176,6 @@ def branches_from(scene, t_end: float, paper_traj: Trajectory, progress=None) ->
     """Every branch from the first undecidable state of `paper_traj`, the scene's run
     under the paper's rule to `t_end` (made here by `branches`, by `harness compare`
     as its reference)."""
-    from reference.continuation import touching_contacts
-
     scene = scene.with_impact_law("paper")
     undecidable = None
     t_u = None
@@ -166,21 +184,16 @@ def branches_from(scene, t_end: float, paper_traj: Trajectory, progress=None) ->
         t_u = paper_traj.t_final
         y = np.concatenate([paper_traj.position[-1], paper_traj.quaternion[-1],
                             paper_traj.velocity[-1], paper_traj.angular_velocity[-1]])  # fmt: skip
-        contacts = touching_contacts(scene, y, []).tolist()
+        contacts = touching_contacts(scene, y).tolist()
         undecidable = {"t": t_u, "contacts": contacts, "message": paper_traj.message}
     paper = summarise(paper_traj, scene, "paper", "paper", None, t_u)
     if undecidable is None:
         return Spread(scene.name, t_end, None, paper, [])
     out = []
-    for name, law in (
-        ("moreau", "moreau"),
-        ("sequential", "sequential"),
-        ("compliant", "compliant"),
-        ("compliant-mass", "compliant-mass"),
-    ):
+    for law in resolving_laws():
         if progress:
-            progress(f"branches: {name}")
-        out.append(run_branch(scene, t_end, name, law, None, t_u))
+            progress(f"branches: {law.name}")
+        out.append(run_branch(scene, t_end, law.name, law.name, None, t_u))
     # the contacts of the impact: those touching, and those the laws gave impulses
     took = {r["contact"] for b in out for r in b.impacts_at}
     contacts = sorted(set(contacts) | took)

@@ -227,18 +227,14 @@ def add_scale(p: argparse.ArgumentParser) -> None:
 def add_impact_law(p: argparse.ArgumentParser) -> None:
     """--impact-law NAME and --simultaneity-window T: how the reference resolves contacts
     touching together (docs/architecture.md, "Impact laws"); default: the scene's."""
-    from reference.scene import IMPACT_LAWS
+    from reference.core.laws import LAW_NAMES, law_help
 
     p.add_argument(
         "--impact-law",
-        choices=IMPACT_LAWS,
+        choices=LAW_NAMES,
         metavar="NAME",
-        help="impact law of simultaneous impacts in the reference: paper (the run ends "
-        "simultaneous_impact), moreau (Moreau's frictionless law over every touching "
-        "contact), sequential (single impacts, the fastest approach first) or "
-        "compliant (the rigid limit of a spring and dashpot at every touching contact, one "
-        "stiffness everywhere; compliant-mass: stiffness in each contact's effective mass) "
-        "(default: the scene's impact_law, else paper)",
+        help=f"impact law of simultaneous impacts in the reference ({law_help()}; "
+        "default: the scene's impact_law, else paper)",
     )
     p.add_argument(
         "--simultaneity-window",

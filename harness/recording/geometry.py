@@ -20,6 +20,7 @@ import numpy as np
 
 from reference import geometry as G
 from reference import quaternion as qt
+from reference.core.records import RIM_VERTEX_ON_PLANE
 from reference.scene import Scene
 
 TILT_TARGET = 0.35  # rad (20°): the exaggerated largest tilt of the reference
@@ -98,11 +99,12 @@ def contact_points(
     x = np.asarray(position, dtype=float)
     q = np.asarray(quaternion_wxyz, dtype=float)
     gap, _ = G.scene_contact_kinematics(scene, pose_states(x, q))
-    pts = np.array(G.contact_points(scene.body, scene.ground))
-    n_rim = scene.contacts.n_rim
-    rim = x[:, None, :] + qt.rotate(q[:, None, :], pts[None, :n_rim, :])
-    floor = pts[None, n_rim:, :] + gap[:, n_rim:, None] * qt.body_axis(q)[:, None, :]
-    world = np.concatenate([rim, floor], axis=1)
+    contacts = scene.contacts
+    pts = np.array(contacts.points)
+    rim = contacts.of_kind(RIM_VERTEX_ON_PLANE)
+    world = np.empty((len(x), contacts.n, 3))
+    world[:, rim] = x[:, None, :] + qt.rotate(q[:, None, :], pts[None, rim, :])
+    world[:, ~rim] = pts[None, ~rim, :] + gap[:, ~rim, None] * qt.body_axis(q)[:, None, :]
     return world, gap
 
 

@@ -21,6 +21,7 @@ import numpy as np
 import rerun as rr
 
 from reference.contact_kinds import GroundContacts
+from reference.core.records import FLOOR_POINT_ON_FACE
 
 from .rows import time_column
 from .runs import RunView, mismatch_marker
@@ -85,8 +86,9 @@ def _log_impacts(
     as diamonds at bump_path(path)."""
     traj = run.trajectory
     k = traj.impact_contacts().astype(int) if traj.impacts else np.zeros(0, dtype=int)
-    both = 0 < contacts.n_rim < contacts.n
-    on_bump = k >= contacts.n_rim if both else np.zeros(len(k), dtype=bool)
+    bump = contacts.of_kind(FLOOR_POINT_ON_FACE)
+    both = bool(bump.any() and not bump.all())
+    on_bump = bump[k] if both else np.zeros(len(k), dtype=bool)
     series = [(path, ~on_bump, "circle", run.label)]
     if both:
         series.append((bump_path(path), on_bump, "diamond", f"{run.label} bump impacts"))

@@ -70,7 +70,8 @@ def watched_contact(points: np.ndarray, flat: bool):
     on the plane when `flat`, else a floor point under the face."""
     from reference.contact_kinds import GroundContacts
 
-    return GroundContacts(np.ascontiguousarray(points, dtype=float), 1 if flat else 0)
+    points = np.ascontiguousarray(points, dtype=float)
+    return GroundContacts(points, np.full(len(points), _kind(flat), dtype=np.int64))
 
 
 def _kind(flat: bool) -> int:

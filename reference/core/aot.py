@@ -32,14 +32,14 @@ def signatures() -> dict:
     i1 = types.Array(types.int64, 1, "C")
     f8, i8, void = types.float64, types.int64, types.void
     return {
-        "run_events": types.int64(rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2),
+        "run_events": types.int64(rec(R.RUN), f2, f2, f2, f2, f2, f2, f1, i2, f2, f2, f1, i1),
         "quaternion_product_rows": void(f2, f2, f2),
         "quaternion_exp_rows": void(f2, f2),
         "quaternion_log_rows": void(f2, f2),
         "rotate_rows": void(f2, f2, f2),
         "tilt_rows": void(f2, f1),
         "axis_rows": void(f2, f2),
-        "contact_kinematics_rows": void(f2, f2, i8, f2, f2),
+        "contact_kinematics_rows": void(f2, f2, f2, f2),
         "energy_rows": void(f2, i8, f8, f8, f8, f8, f2),
         "free_acceleration_rows": void(f2, f8, f8, f8, f2),
         "length_scale_rows": void(f2, f8, f1),

@@ -6,9 +6,8 @@ written into the arrays given."""
 
 from numba import njit
 
-from .contacts import contact_frame, length_scale, normal_velocity
+from .contacts import contact_frame, contact_kind, length_scale, normal_velocity
 from .inertia import excess_energy, free_acceleration, kinetic_energy, potential_energy
-from .records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE
 from .rotation import (
     axis_of,
     qmul,
@@ -62,13 +61,13 @@ def axis_rows(q, out):
 
 
 @njit(cache=True)
-def contact_kinematics_rows(states, pts, n_rim, gap, vn):
+def contact_kinematics_rows(states, pts, gap, vn):
     """gap[i, k] and vn[i, k]: gap and normal velocity of contact k at state i (the
-    ground's contacts: n_rim rim vertices, then floor points, `contacts.contact_kind`)."""
+    ground's contacts, each of its stored kind: `contacts.contact_kind`)."""
     for i in range(states.shape[0]):
         y = states[i]
         for k in range(pts.shape[0]):
-            kind = RIM_VERTEX_ON_PLANE if k < n_rim else FLOOR_POINT_ON_FACE
+            kind = contact_kind(pts, k)
             f = contact_frame(y, kind, pts, k)
             gap[i, k] = f.gap
             vn[i, k] = normal_velocity(y, f, kind)

@@ -51,7 +51,7 @@ def _list_free(state, cs, first, count, n, m):
 def _jets(y, model, pts, acc, cs, i0, i1):
     """Jets of cs.cand[i0:i1] with the held acceleration acc."""
     for i in range(i0, i1):
-        j = contact_jet(y, contact_kind(model, cs.cand[i]), pts, cs.cand[i], acc)
+        j = contact_jet(y, contact_kind(pts, cs.cand[i]), pts, cs.cand[i], acc)
         cs.gap[i], cs.rate[i], cs.accel[i], cs.noise[i] = j.gap, j.rate, j.accel, j.noise
 
 

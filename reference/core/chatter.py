@@ -27,7 +27,7 @@ def completion_speed(y, model, pts, k, chatter_tol, vnoise):
     if bounce_ratio(model.gamma) >= 1.0:
         return vnoise
     small = chatter_tol * velocity_scale(y, model.radius)
-    noise = contact_frame(y, contact_kind(model, k), pts, k).noise
+    noise = contact_frame(y, contact_kind(pts, k), pts, k).noise
     a_scale = model.gravity + model.radius * (y[WX] ** 2 + y[WY] ** 2 + y[WZ] ** 2)
     return max(small, CHATTER_BOUNCE_FLOOR * math.sqrt(2.0 * a_scale * noise), vnoise)
 

@@ -402,3 +402,17 @@ def _run(W, u_pre, gamma, k, wbar, ubar, work, active, mass_scaled):
         if switches > MAX_SWITCHES_PER_CONTACT * k + 64:
             return NOT_SETTLED
     return NOT_SETTLED
+
+
+@hot
+def compliant_law(W, u_pre, gamma, k, lam, u_post, work):
+    """`compliant_impulses` in the registry's signature (reference.core.laws): one
+    impact (work.vec: work_size(k) floats)."""
+    return compliant_impulses(W, u_pre, gamma, k, lam, u_post, work.vec, work.active), 1
+
+
+@hot
+def compliant_mass_law(W, u_pre, gamma, k, lam, u_post, work):
+    """`compliant_mass_impulses` in the registry's signature (reference.core.laws)."""
+    status = compliant_mass_impulses(W, u_pre, gamma, k, lam, u_post, work.vec, work.active)
+    return status, 1

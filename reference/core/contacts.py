@@ -1,8 +1,10 @@
 """The contact kinds: the geometry of one contact at a state (the model of Baranyai &
 Várkonyi, section 2).  A ground is a list of contacts, each of a kind
-(`records.RIM_VERTEX_ON_PLANE`, `records.FLOOR_POINT_ON_FACE`): its rim vertices first,
-contacts 0 … model.n_rim − 1, then its floor points (`contact_kind`).  `pts[k]` is
-contact k's point: body-frame for a rim vertex, world for a floor point.
+(`records.RIM_VERTEX_ON_PLANE`, `records.FLOOR_POINT_ON_FACE`), stored with the
+contact: `pts[k, :3]` is contact k's point (body-frame for a rim vertex, world for a
+floor point), `pts[k, KIND_COLUMN]` its kind (`contact_kind`).  Its rim vertices come
+first, contacts 0 … model.n_rim − 1 in order round the rim (the searches' windows
+over vertex indices rely on it), then its floor points.
 
 - RIM_VERTEX_ON_PLANE: the body point p_k = a(cos 2πk/n, sin 2πk/n, 0) against the
   plane z = 0; lever r = R p_k, gap g = z + r_z, normal n = e_z (paper eq. rig, exact
@@ -24,22 +26,16 @@ import math
 
 from .jit import hot
 from .layout import VX, VY, VZ, WX, WY, WZ, X, Y, Z
-from .records import FLOOR_POINT_ON_FACE, RIM_VERTEX_ON_PLANE, Frame, Jet
+from .records import KIND_COLUMN, RIM_VERTEX_ON_PLANE, Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
 from .tolerances import EPS, GAP_NOISE_ULPS, RATE_NOISE_ULPS, SIMULTANEOUS_FACTOR, TINY
 
 
 @hot
-def contact_kind(model, k):
-    """The kind of the ground's contact k (`kind_in_ground` with model.n_rim)."""
-    return kind_in_ground(model.n_rim, k)
-
-
-@hot
-def kind_in_ground(n_rim, k):
-    """The kind of contact k of a ground whose rim vertices come first (n_rim of them)
-    and its floor points after (for loops over contacts, n_rim read once)."""
-    return RIM_VERTEX_ON_PLANE if k < n_rim else FLOOR_POINT_ON_FACE
+def contact_kind(pts, k):
+    """The kind of contact k, stored with its point: pts[k, KIND_COLUMN]
+    (records.KIND_COLUMN)."""
+    return int(pts[k, KIND_COLUMN])
 
 
 @hot
@@ -98,7 +94,7 @@ def off_face(y, model, pts, k):
     outside its rim, |lever| > a, beside the body, not under it (the model's contact
     does not exist there: the body has left the bumps).  Never a rim vertex, a point of
     the body itself."""
-    if contact_kind(model, k) == RIM_VERTEX_ON_PLANE:
+    if contact_kind(pts, k) == RIM_VERTEX_ON_PLANE:
         return False
     f = bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
     return f.rx * f.rx + f.ry * f.ry + f.rz * f.rz > model.radius * model.radius
@@ -243,7 +239,8 @@ def reached_together(gap, rate, noise, tres0, rate0, window_per_speed):
     (the model cannot order them) plus the simultaneity window on the motion's scale,
     T |rate0|/U (model.window_per_speed = T/U, U the scene's velocity unit; T = 0:
     strictly sequential).  Scaled by the speed, the window keeps apart the late impacts
-    of a cascade, whose intervals shrink with the speeds (docs/laws.md, "The simultaneity window")."""
+    of a cascade, whose intervals shrink with the speeds (docs/laws.md, "The
+    simultaneity window")."""
     window = window_per_speed * abs(rate0)
     return gap / -rate <= SIMULTANEOUS_FACTOR * (time_resolution(noise, rate) + tres0) + window
 
@@ -255,7 +252,7 @@ def approaching_contacts(y, model, pts, contacts, n, vnoise, out):
     that hit when a contact phase reaches several together)."""
     m = 0
     for i in range(n):
-        kind = contact_kind(model, contacts[i])
+        kind = contact_kind(pts, contacts[i])
         if normal_velocity(y, contact_frame(y, kind, pts, contacts[i]), kind) < -vnoise:
             out[m] = contacts[i]
             m += 1

@@ -201,7 +201,7 @@ def _lowest_gap(y, model, pts, watch, n_watch):
     """The smallest gap among contacts watch[:n_watch] at y."""
     g = math.inf
     for i in range(n_watch):
-        g = min(g, contact_frame(y, contact_kind(model, watch[i]), pts, watch[i]).gap)
+        g = min(g, contact_frame(y, contact_kind(pts, watch[i]), pts, watch[i]).gap)
     return g
 
 

@@ -1,5 +1,6 @@
 """Instantaneous events of the loop: an impact (with the chatter completion and the
-contacts it leaves held), an activation (contacts landing at rest start to be held),
+contacts it leaves held; several contacts at once under an impact law,
+reference.core.law_event), an activation (contacts landing at rest start to be held),
 and the start of the run.  Each returns False when it ended the run (state.status
 set), True otherwise."""
 
@@ -18,6 +19,8 @@ from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
 from .jit import copy_into, hot
+from .law_event import law_event
+from .laws import LAW_PAPER
 from .output import push_accumulation, push_impact, push_sample
 from .records import (
     STATUS_AT_REST,
@@ -71,12 +74,27 @@ def _completes(state, model, pts, ws, k, m, u, vnoise):
     """Whether contact k, separating at u ≤ the completion speed with cand[:m] held,
     falls back (a_n < 0) or is at rest: then its chatter is completed."""
     acc = held_acceleration(state.y, model, pts, ws.cand, m, ws)
-    a_n = contact_jet(state.y, contact_kind(model, k), pts, k, acc).accel
+    a_n = contact_jet(state.y, contact_kind(pts, k), pts, k, acc).accel
     return a_n < 0 or u <= vnoise, a_n
 
 
 @hot
-def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, resting, n_rest):
+def _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, resting, n_rest):
+    """The impact of hitting[:n_hit] with resting[:n_rest] and every contact touching
+    them, under the run's impact law (law_event)."""
+    named = cs.near  # (free at an event; n long: the contacts named are distinct)
+    m = 0
+    for i in range(n_hit):
+        named[m] = hitting[i]
+        m += 1
+    for i in range(n_rest):
+        named[m] = resting[i]
+        m += 1
+    return law_event(state, model, pts, opts, stats, out, ws, cs, named, m)
+
+
+@hot
+def resolve_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, resting, n_rest):
     """The impact of hitting[0] with resting[:n_rest] held (paper §2.3), then the
     contacts to hold: resting ones left at rest or separating slower than the completion
     speed, and the hit one if its chatter is completed."""
@@ -86,11 +104,14 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
             end_run(state, STATUS_OFF_FACE, hitting[i:], 1)
             return False
     if n_hit > 1:
+        if model.law != LAW_PAPER:
+            return _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit,
+                               resting, n_rest)  # fmt: skip
         end_run(state, STATUS_SIMULTANEOUS, hitting, n_hit)
         return False
     k = hitting[0]
     stats.max_penetration = max(
-        stats.max_penetration, -contact_frame(y, contact_kind(model, k), pts, k).gap
+        stats.max_penetration, -contact_frame(y, contact_kind(pts, k), pts, k).gap
     )
     vnoise = rate_noise(y, model.radius)
     copy_into(ws.y_start, y)
@@ -98,6 +119,9 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
     n_pushed = pushed_contacts(y, model, pts, resting, n_rest, vnoise, ws.before)
     if n_pushed > 0:
         copy_into(y, ws.y_start)
+        if model.law != LAW_PAPER:
+            return _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, 1,
+                               resting, n_rest)  # fmt: skip
         state.info_contact = k
         end_run(state, STATUS_PUSHED, ws.before, n_pushed)
         return False
@@ -106,7 +130,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, hitting, n_hit, rest
     m = 0
     vs = velocity_scale(y, model.radius)
     for i in range(n_rest):
-        kind = contact_kind(model, resting[i])
+        kind = contact_kind(pts, resting[i])
         vn = normal_velocity(y, contact_frame(y, kind, pts, resting[i]), kind)
         if vn <= small:
             ws.cand[m] = resting[i]
@@ -211,11 +235,23 @@ def start(state, model, pts, opts, stats, out, ws, cs):
         state.started = True
         end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
         return False
+    state.started = True
+    return resolve_touching(state, model, pts, opts, stats, out, ws, cs)
+
+
+@hot
+def resolve_touching(state, model, pts, opts, stats, out, ws, cs):
+    """The contacts touching at the current time, with no contact held: those hitting
+    are an impact with the resting ones held; resting only: hold them (all of them:
+    the motion has ended).  The run's start, and the step after a law impact."""
+    y = state.y
+    state.recheck = False
+    state.n_active = 0
     vnoise = rate_noise(y, model.radius)
     n_hit = n_rest = 0
     hitting, resting = cs.hitting, cs.together
     for k in range(pts.shape[0]):
-        kind = contact_kind(model, k)
+        kind = contact_kind(pts, k)
         f = contact_frame(y, kind, pts, k)
         if f.gap > f.noise:
             continue
@@ -226,10 +262,9 @@ def start(state, model, pts, opts, stats, out, ws, cs):
         elif abs(vn) <= vnoise:
             resting[n_rest] = k
             n_rest += 1
-    state.started = True
     if n_hit:
         return resolve_impact(
-            state, model, pts, opts, stats, out, ws, hitting, n_hit, resting, n_rest
+            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, resting, n_rest
         )
     if n_rest >= model.all_down:
         end_run(state, STATUS_AT_REST, resting, n_rest)

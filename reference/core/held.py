@@ -52,7 +52,7 @@ def contact_system(y, model, pts, idx, m, acc, work):
     forces when acc is the free acceleration), work.resp rows = M⁻¹J_iᵀ and w_i, for
     the contacts idx[:m]."""
     for i in range(m):
-        kind = contact_kind(model, idx[i])
+        kind = contact_kind(pts, idx[i])
         f = contact_frame(y, kind, pts, idx[i])
         rsp = impulse_response(y, f, model.mass, model.i1, model.i3)
         work.resp[i, 0], work.resp[i, 1], work.resp[i, 2] = rsp.dvx, rsp.dvy, rsp.dvz
@@ -121,7 +121,7 @@ def zero_normal_velocities(y, model, pts, idx, m, work):
     acc = free_acceleration(y, model.i1, model.i3, model.gravity)
     contact_system(y, model, pts, idx, m, acc, work)
     for i in range(m):
-        kind = contact_kind(model, idx[i])
+        kind = contact_kind(pts, idx[i])
         work.r[i] = -normal_velocity(y, contact_frame(y, kind, pts, idx[i]), kind)
     if not solve_small(work.A, work.r, m, work.lam):
         return False
@@ -136,7 +136,7 @@ def _gaps_settled(y, model, pts, idx, m, work):
     """work.r = −gaps of contacts idx[:m]; whether each is within its roundoff."""
     settled = True
     for i in range(m):
-        f = contact_frame(y, contact_kind(model, idx[i]), pts, idx[i])
+        f = contact_frame(y, contact_kind(pts, idx[i]), pts, idx[i])
         work.r[i] = -f.gap
         if abs(f.gap) > f.noise:
             settled = False

@@ -56,7 +56,7 @@ def chatter_impulse(u_post, w, gamma):
 @hot
 def impact(y, model, pts, k):
     """In place: the impact of contact k on state y (positions unchanged)."""
-    kind = contact_kind(model, k)
+    kind = contact_kind(pts, k)
     f = contact_frame(y, kind, pts, k)
     u_pre = normal_velocity(y, f, kind)
     resp = impulse_response(y, f, model.mass, model.i1, model.i3)

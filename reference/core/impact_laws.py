@@ -8,7 +8,7 @@ caller applies (v, ω) += M⁻¹JᵀΛ.  They allocate nothing: the caller passe
 (`W`, `chol` at least k × k; `lam`, `u_post`, `vec` at least k long, `vec` 2k; `active`
 k integers).
 
-Laws (`LAW_*`; their names in `LAW_NAMES`):
+Laws (registered in reference.core.laws, which names them and gives their codes):
 
 - `paper`: the paper's rule: one single impact (eq. F) at a time; two contacts reached
   together, or a single impact that pushes a held contact, is undecidable (the run
@@ -52,13 +52,6 @@ import math
 
 from .impact import post_impact_velocity
 from .jit import hot
-
-LAW_PAPER = 0
-LAW_MOREAU = 1
-LAW_SEQUENTIAL = 2
-LAW_COMPLIANT = 3
-LAW_COMPLIANT_MASS = 4
-LAW_NAMES = ("paper", "moreau", "sequential", "compliant", "compliant-mass")
 
 # Outcomes of a law's solve
 SETTLED = 0
@@ -316,3 +309,18 @@ def sequential_impulses(W, u_pre, gamma, k, order, n_order, lam, u_post, max_hit
         u_post[j] = post_impact_velocity(u_j, gamma)  # exactly, as eq. F makes it
         hits += 1
     return NOT_SETTLED, hits
+
+
+@hot
+def moreau_law(W, u_pre, gamma, k, lam, u_post, work):
+    """Moreau's law in the registry's signature (reference.core.laws): one impact."""
+    status = moreau_impulses(W, u_pre, gamma, k, lam, u_post, work.chol, work.vec, work.active)
+    return status, 1
+
+
+@hot
+def sequential_law(W, u_pre, gamma, k, lam, u_post, work):
+    """The sequential law in the registry's signature (reference.core.laws)."""
+    return sequential_impulses(
+        W, u_pre, gamma, k, work.order, work.n_order, lam, u_post, work.max_hits
+    )

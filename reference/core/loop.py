@@ -6,7 +6,9 @@ points, separated by instantaneous events: single-point Newtonian impacts, lift-
 explicit status and never guesses:
 
 - two contacts reached within the time resolution, or an impact that would drive a
-  held contact into the ground (the paper's rule), end it as undecidable;
+  held contact into the ground, end it as undecidable under the paper's rule; under an
+  impact law they are one simultaneous impact, resolved by the law
+  (reference.core.law_event), and the run goes on;
 - all contacts down, the energy above the resting level exhausted to `energy_floor`
   of its initial value, or the tilt below TILT_FLOOR, end it at the singularity, with
   t_singularity (extrapolated from the geometric sequence of the last impact
@@ -27,7 +29,7 @@ from numba import njit
 
 from .clock import time_until
 from .contacts import off_face, velocity_scale
-from .events import end_run, start
+from .events import end_run, resolve_touching, start
 from .inertia import excess_energy
 from .jit import hot
 from .layout import QX, QY, STATE_SIZE, WX, WY
@@ -37,6 +39,7 @@ from .phases import (
     begin_contact_phase,
     close_contact_phase,
     contact_step,
+    flat_flight_step,
     flight_step,
 )
 from .records import (
@@ -143,11 +146,12 @@ def _motion_ended(state, model, opts, out):
 
 
 @hot
-def _rows_short(out):
-    """Whether impacts, phases or accumulation times have fewer than STEP_ROWS free rows."""
+def _rows_short(out, opts):
+    """Whether impacts have fewer than opts.step_rows free rows, phases or accumulation
+    times fewer than STEP_ROWS."""
     c = out.counts
     return (
-        out.impacts.shape[0] - c[N_IMPACTS] < STEP_ROWS
+        out.impacts.shape[0] - c[N_IMPACTS] < opts.step_rows
         or out.phases.shape[0] - c[N_PHASES] < STEP_ROWS
         or out.accumulations.shape[0] - c[N_ACCUMULATIONS] < STEP_ROWS
     )
@@ -195,10 +199,15 @@ def loop_step(state, model, pts, opts, stats, out, ws, cs):
     if not state.started:
         start(state, model, pts, opts, stats, out, ws, cs)
         return 0
+    if state.recheck:
+        resolve_touching(state, model, pts, opts, stats, out, ws, cs)
+        return 0
     if state.in_contact:
         return contact_step(state, model, pts, opts, stats, out, ws, cs)
     if _motion_ended(state, model, opts, out):
         return 0
+    if state.flat_u > 0.0:
+        return flat_flight_step(state, model, pts, opts, stats, out, ws, cs)
     if state.n_active > 0:
         begin_contact_phase(state, model, opts)
         return contact_step(state, model, pts, opts, stats, out, ws, cs)
@@ -208,7 +217,7 @@ def loop_step(state, model, pts, opts, stats, out, ws, cs):
 @njit(cache=True)
 def run_events(
     run_rec, pts, sample_t, sample_y, sample_e, impacts, phases, accumulations,
-    contact_ints, contact_floats,
+    contact_ints, contact_floats, law_mats, law_vecs, law_ints,
 ):  # fmt: skip
     """Run the loop from the state in run_rec until the run ends (RETURN_DONE), an output
     array needs rows (RETURN_GROW) or work_budget steps are done (RETURN_YIELD).
@@ -216,15 +225,16 @@ def run_events(
     counters, scratch and output row counts), so that it outlives the call (a record
     does not keep its array alive); the output arrays are those of output.Output;
     contact_ints and contact_floats hold the per-contact lists
-    (records.new_contact_arrays)."""
+    (records.new_contact_arrays), law_mats, law_vecs and law_ints the scratch of a
+    simultaneous impact under an impact law (records.new_law_arrays)."""
     run = run_rec[0]
     model, opts, state, stats, ws = run.model, run.options, run.state, run.stats, run.scratch
     out = Output(sample_t, sample_y, sample_e, impacts, phases, accumulations, run.counts)
-    cs = contact_lists(contact_ints, contact_floats)
+    cs = contact_lists(contact_ints, contact_floats, law_mats, law_vecs, law_ints)
     for _ in range(opts.work_budget):
         if state.status != STATUS_RUNNING:
             return RETURN_DONE
-        if _rows_short(out):
+        if _rows_short(out, opts):
             return RETURN_GROW
         if loop_step(state, model, pts, opts, stats, out, ws, cs) == NEEDS_ROWS:
             return RETURN_GROW

@@ -4,33 +4,25 @@ impulses (reference.core.impact_laws), and (v, ω) += M⁻¹JᵀΛ.  Positions a
 (paper §2.3: impacts are instantaneous)."""
 
 from .chatter import completion_speed
-from .compliant import compliant_impulses, compliant_mass_impulses
 from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
-from .impact_laws import (
-    LAW_COMPLIANT,
-    LAW_COMPLIANT_MASS,
-    LAW_MOREAU,
-    LAW_SEQUENTIAL,
-    NOT_SETTLED,
-    SETTLED,
-    moreau_impulses,
-    sequential_impulses,
-)
+from .impact_laws import SETTLED
 from .inertia import apply_impulse, impulse_response, response_rate
 from .jit import hot
+from .law_dispatch import solve_law
+from .records import LawWork
 
 
 @hot
 def delassus_system(y, model, pts, contacts, k, W, u):
     """W[:k, :k] = J M⁻¹ Jᵀ and u[:k] = J (v, ω) for the contacts[:k] at state y."""
     for i in range(k):
-        ki = contact_kind(model, contacts[i])
+        ki = contact_kind(pts, contacts[i])
         fi = contact_frame(y, ki, pts, contacts[i])
         u[i] = normal_velocity(y, fi, ki)
         resp = impulse_response(y, fi, model.mass, model.i1, model.i3)
         W[i, i] = resp.w
         for j in range(i):
-            fj = contact_frame(y, contact_kind(model, contacts[j]), pts, contacts[j])
+            fj = contact_frame(y, contact_kind(pts, contacts[j]), pts, contacts[j])
             W[i, j] = W[j, i] = response_rate(fj, resp)
 
 
@@ -39,7 +31,7 @@ def apply_impulses(y, model, pts, contacts, k, lam):
     """In place: (v, ω) += Σ Λᵢ M⁻¹Jᵢᵀ."""
     for i in range(k):
         if lam[i] != 0.0:
-            f = contact_frame(y, contact_kind(model, contacts[i]), pts, contacts[i])
+            f = contact_frame(y, contact_kind(pts, contacts[i]), pts, contacts[i])
             apply_impulse(y, impulse_response(y, f, model.mass, model.i1, model.i3), lam[i])
 
 
@@ -48,11 +40,11 @@ def law_impact(
     y, model, pts, law, contacts, k, order, n_order, max_hits, chatter_tol,
     W, u_pre, lam, u_post, chol, vec, active, result,
 ):  # fmt: skip
-    """In place: the impact of contacts[:k] on state y under `law` (LAW_MOREAU,
-    LAW_SEQUENTIAL or LAW_COMPLIANT; order[:n_order] the sequential law's order, empty: the fastest
-    first), restitution model.gamma.  Fills u_pre, lam, u_post (per contact) and
-    result[:3] = (status, number of single impacts: 1 for Moreau, 1 if the bounces were
-    completed); y changes only when the law settled.
+    """In place: the impact of contacts[:k] on state y under `law` (a code of
+    reference.core.laws; order[:n_order] the sequential law's order as positions in
+    contacts, empty: the fastest first), restitution model.gamma.  Fills u_pre, lam,
+    u_post (per contact) and result[:3] = (status, number of single impacts: 1 for
+    Moreau, 1 if the bounces were completed); y changes only when the law settled.
 
     Chatter completion, as for a single impact (reference.core.chatter): when every
     contact that leaves, leaves slower than its `completion_speed`, the bounces that
@@ -91,21 +83,8 @@ def _solve_law(
     gamma, law, k, order, n_order, max_hits, W, u_pre, lam, u_post, chol, vec, active, result
 ):
     """The law's impulses for restitution gamma: result[:2] = (status, single impacts)."""
-    if law == LAW_MOREAU:
-        status = moreau_impulses(W, u_pre, gamma, k, lam, u_post, chol, vec, active)
-        hits = 1
-    elif law == LAW_SEQUENTIAL:
-        status, hits = sequential_impulses(
-            W, u_pre, gamma, k, order, n_order, lam, u_post, max_hits
-        )
-    elif law == LAW_COMPLIANT:
-        status = compliant_impulses(W, u_pre, gamma, k, lam, u_post, vec, active)
-        hits = 1
-    elif law == LAW_COMPLIANT_MASS:
-        status = compliant_mass_impulses(W, u_pre, gamma, k, lam, u_post, vec, active)
-        hits = 1
-    else:
-        status, hits = NOT_SETTLED, 0
+    work = LawWork(chol, vec, active, order, n_order, max_hits)
+    status, hits = solve_law(law, W, u_pre, gamma, k, lam, u_post, work)
     result[0], result[1] = status, hits
 
 

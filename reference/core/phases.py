@@ -38,7 +38,8 @@ from .floor import below_floor, floor_gap, floor_horizon, floor_reach, has_floor
 from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
-from .jit import copy_into, hot
+from .jit import copy_into, hot, hot_inline
+from .law_event import law_event
 from .layout import VX, VY, VZ, WX, WY, WZ
 from .output import push_phase, push_sample
 from .records import (
@@ -136,6 +137,28 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
         return NEEDS_ROWS
     stats.flight_searches += 1
     stats.search_iterations += ev.iterations
+    fly_to(state, model, opts, out, ws, fc, s_end, n_grid)
+    if s_floor >= 0.0:
+        end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
+        return DONE
+    if ev.kind == EVENT_NONE:
+        return DONE
+    if ev.kind == EVENT_ACTIVATION:
+        activate(state, model, pts, ws, stats, cs.together, ev.n_together)
+        return DONE
+    resolve_impact(
+        state, model, pts, opts, stats, out, ws, cs, cs.together, ev.n_together, state.active, 0
+    )
+    return DONE
+
+
+@hot_inline
+def fly_to(state, model, opts, out, ws, fc, s_end, n_grid):
+    """The free flight from the state to ws.y_event at s_end: its n_grid grid samples
+    (`grid_count`, their rows checked by `_needed`), its phase row, the state and time
+    advanced.  Inlined where it is called (numba's IR inlining): a call of its own
+    cost `flight_step` 5 % of a bouncing run's instructions."""
+    y = state.y
     k, dt, n = grid_times(state.t_hi, state.t_lo, s_end, opts.sample_dt, n_grid + 1)
     for i in range(n):
         s = grid_time(k + i, dt, state.t_hi, state.t_lo)
@@ -147,17 +170,32 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     copy_into(y, ws.y_event)
     push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
-    if s_floor >= 0.0:
-        end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
-        return DONE
-    if ev.kind == EVENT_NONE:
-        return DONE
-    if ev.kind == EVENT_ACTIVATION:
-        activate(state, model, pts, ws, stats, cs.together, ev.n_together)
-        return DONE
-    resolve_impact(
-        state, model, pts, opts, stats, out, ws, cs.together, ev.n_together, state.active, 0
-    )
+
+
+@hot
+def flat_flight_step(state, model, pts, opts, stats, out, ws, cs):
+    """The flight after a flat bounce (law_event): the body left every contact at one
+    speed u = state.flat_u, flat, so it lands flat again after 2u/g (its height returns
+    in closed form; its attitude, turning about the vertical, stays flat), where the
+    law resolves the landing on all its contacts.  The run's end (t_end) comes first
+    when it is sooner."""
+    y = state.y
+    s_end = 2.0 * state.flat_u / model.gravity
+    remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
+    landing = s_end <= remaining
+    if not landing:
+        s_end = remaining
+    n_grid = grid_count(state.t_hi, state.t_lo, s_end, opts.sample_dt)
+    if _needed(n_grid, out, opts):
+        return NEEDS_ROWS
+    fc = flight_constants(y, model.i1, model.i3)
+    free_flight(y, fc, model.gravity, s_end, ws.y_event)
+    fly_to(state, model, opts, out, ws, fc, s_end, n_grid)
+    state.flat_u = 0.0
+    if landing:
+        for i in range(model.n_contacts):
+            cs.near[i] = i
+        law_event(state, model, pts, opts, stats, out, ws, cs, cs.near, model.n_contacts)
     return DONE
 
 
@@ -229,7 +267,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, hitting, n_hit, ws.held, state.n_active
+            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, ws.held, state.n_active
         )
         return True
     if n_land:
@@ -334,7 +372,7 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
         k = (first + i) % n
         if is_held(state, k):
             continue
-        f = contact_frame(y, contact_kind(model, k), pts, k)
+        f = contact_frame(y, contact_kind(pts, k), pts, k)
         if f.gap < -max(f.noise, gap_res):
             cs.together[m] = k
             m += 1
@@ -357,7 +395,18 @@ def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, cs.hitting, n_hit, ws.held, state.n_active
+            state,
+            model,
+            pts,
+            opts,
+            stats,
+            out,
+            ws,
+            cs,
+            cs.hitting,
+            n_hit,
+            ws.held,
+            state.n_active,
         )
         return DONE
     activate(state, model, pts, ws, stats, cs.together, n_crossed)

@@ -30,6 +30,11 @@ ImpactOutcome = namedtuple("ImpactOutcome", ["impulse", "u_pre", "u_post"])
 # contact, how many contacts are reached together, search iterations.
 FlightEvent = namedtuple("FlightEvent", ["kind", "s", "contact", "n_together", "iterations"])
 
+# The scratch and settings an impact law's function may use (reference.core.laws):
+# chol (k × k), vec (2k), active (k integers), the sequential law's order[:n_order] and
+# its cap on single impacts.
+LawWork = namedtuple("LawWork", ["chol", "vec", "active", "order", "n_order", "max_hits"])
+
 EVENT_NONE = 0  # nothing reached within the horizon
 EVENT_IMPACT = 1  # a contact reached while approaching
 EVENT_ACTIVATION = 2  # a contact touching at rest with its acceleration into the ground
@@ -41,6 +46,12 @@ EVENT_STUCK = 3  # the search did not converge
 # describes a ground with them, reference.ground).
 RIM_VERTEX_ON_PLANE = 0  # a body-frame rim vertex against the plane z = 0, normal +z
 FLOOR_POINT_ON_FACE = 1  # a fixed world point touching the body's face, normal e3
+
+# The core's contact points are (n, POINT_COLUMNS) rows: the point (body-frame for a rim
+# vertex, world for a floor point) and, in column KIND_COLUMN, the contact's kind
+# (reference.contact_kinds.GroundContacts.core_points).
+KIND_COLUMN = 3
+POINT_COLUMNS = 4
 
 # Invariants of the motion that every contact force of a ground keeps (bits): vertical
 # forces keep the horizontal momentum and L_z; forces along e3 through the face keep
@@ -70,6 +81,8 @@ MODEL = np.dtype(
         ("window_per_speed", np.float64),
         ("floor_depth", np.float64),  # d: the floor plane z = −d, a model limit of a ground
         # without rim vertices (reference.core.floor); inf: none
+        ("law", np.int64),  # the impact law's code (reference.core.laws)
+        ("law_separating", np.bool_),  # its impact takes separating contacts too
     ]
 )
 
@@ -85,6 +98,9 @@ OPTIONS = np.dtype(
         ("max_impacts", np.int64),
         ("window_search", np.bool_),  # large polygons: examine only the vertices near the ground
         ("work_budget", np.int64),  # loop steps per call before control returns to Python
+        ("n_order", np.int64),  # the sequential law's order: ContactLists.order[:n_order]
+        ("step_rows", np.int64),  # impact rows a step may add: STEP_ROWS, + the law's
+        # contacts when a law resolves simultaneous impacts (one row per contact)
     ]
 )
 
@@ -115,6 +131,12 @@ STATE = np.dtype(
         ("stall_t", np.float64),  # the time and event count of the last step that
         ("stall_events", np.int64),  # advanced, and how many steps since have not
         ("stall_steps", np.int64),
+        ("recheck", np.bool_),  # after a law impact: resolve the touching contacts
+        ("law_t_hi", np.float64),  # the time of the last law impact and how many
+        ("law_t_lo", np.float64),  # happened at it (reference.core.law_event)
+        ("law_repeats", np.int64),
+        ("law_outcome", np.int64),  # why a law left the impact undecided (law_event)
+        ("flat_u", np.float64),  # > 0: flying after a flat bounce at this speed (law_event)
     ]
 )
 
@@ -134,6 +156,8 @@ STATUS_AT_REST = 11  # singularity at the start: all contacts down and at rest
 STATUS_TILT_FLOOR = 12  # singularity: tilt below TILT_FLOOR after impacts
 STATUS_OFF_FACE = 13  # a floor point outside the face's rim (contacts.off_face): left the bumps
 STATUS_BELOW_FLOOR = 14  # the rim reached the floor plane of a ground without rim contacts
+STATUS_LAW_UNDECIDED = 15  # the impact law left a simultaneous impact undecided
+STATUS_FLAT_REST = 16  # singularity: flat bounces completed, at rest (law_event)
 
 # Counters of a run (reference.stats.RunStats reads them by name).
 STATS = np.dtype(
@@ -151,6 +175,7 @@ STATS = np.dtype(
         ("contact_energy_drift_max", np.float64),
         ("max_penetration", np.float64),
         ("loop_steps", np.int64),
+        ("simultaneous_impacts", np.int64),  # resolved by the impact law in the loop
     ]
 )
 
@@ -218,6 +243,16 @@ def new_contact_arrays(n):
         np.empty((len(CONTACT_INT_ROWS), n), dtype=np.int64),
         np.empty((len(CONTACT_FLOAT_ROWS), n)),
     )
+
+
+def new_law_arrays(k, order=(), work=None):
+    """The float (2k, k), float (3k + work,) and int (3k + len(order),) arrays of a
+    simultaneous impact of up to k contacts under an impact law (workspace.ContactLists):
+    `work` floats of the law's scratch (laws.work_floats; None: 2k), the sequential
+    law's order of contacts after the int rows."""
+    ints = np.zeros(3 * k + len(order), dtype=np.int64)
+    ints[3 * k :] = order
+    return np.zeros((2 * k, k)), np.zeros(3 * k + (2 * k if work is None else work)), ints
 
 
 # Columns of the impact rows the loop writes.

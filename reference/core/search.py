@@ -25,7 +25,6 @@ from .contacts import (
     contact_jet,
     contact_kind,
     frame_and_rate,
-    kind_in_ground,
     normal_acceleration,
     rate_noise,
     reached_together,
@@ -201,7 +200,9 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
     other, other_k = math.inf, -1.0
     if n_rim < n:
         cols = rotation_columns_xy(y)  # (unused by a floor point's frame)
-        for k in range(n_rim, n):  # the floor points (`contacts.kind_in_ground`)
+        for k in range(n_rim, n):  # the floor points, after the rim vertices: their
+            # kind as a constant keeps `examine` inlined for it (docs/performance.md,
+            # "Event search"); GroundContacts lists each kind in one range
             examine(y, acc, cols, FLOOR_POINT_ON_FACE, pts, k, K, B, vnoise, res)
         if n_rim == 0:
             return res[STEP], last_dlt
@@ -252,14 +253,13 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     if windowed:
         first, half = vertex_window(y, model.radius, n, K, end, 3)
     t = end
-    n_rim = model.n_rim
     cols = rotation_columns_xy(y)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, j = next_index(nxt, n), nxt
         if j == k:
             continue
-        kind = kind_in_ground(n_rim, j)
+        kind = contact_kind(pts, j)
         f, rate = frame_and_rate(y, cols, kind, pts, j)
         g = f.gap
         if g <= f.noise:
@@ -311,7 +311,7 @@ def bracketed_zero(y0, fc, bounds, model, pts, s, step, horizon, acc, vnoise, wi
     returns its time with y there (the impact test of `examine` holds there), or −1
     when the shortcut does not apply (y then undefined)."""
     k = int(res[STEP_K])
-    kind = contact_kind(model, k)
+    kind = contact_kind(pts, k)
     j = contact_jet(y, kind, pts, k, acc)
     if j.gap <= j.noise:
         return -1.0
@@ -371,18 +371,18 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
     """Contacts reached with k0 at state y (k0 first): approaching, with a zero within
     SIMULTANEOUS_FACTOR × (their time resolution + k0's).  Returns how many."""
     cols = rotation_columns_xy(y)
-    f0, rate0 = frame_and_rate(y, cols, contact_kind(model, k0), pts, k0)
+    f0, rate0 = frame_and_rate(y, cols, contact_kind(pts, k0), pts, k0)
     tres0 = time_resolution(f0.noise, rate0)
     together[0] = k0
     count = 1
-    n, n_rim = pts.shape[0], model.n_rim
+    n = pts.shape[0]
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
         if k == k0:
             continue
-        f, rate = frame_and_rate(y, cols, kind_in_ground(n_rim, k), pts, k)
+        f, rate = frame_and_rate(y, cols, contact_kind(pts, k), pts, k)
         if rate >= -vnoise:
             continue
         if reached_together(f.gap, rate, f.noise, tres0, rate0, model.window_per_speed):
@@ -395,12 +395,12 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
 def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     """Contacts touching at rest and accelerating into the ground at state y."""
     count = 0
-    n, n_rim = pts.shape[0], model.n_rim
+    n = pts.shape[0]
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n
     for _ in range(min(2 * half + 1, n)):
         nxt, k = next_index(nxt, n), nxt
-        j = contact_jet(y, kind_in_ground(n_rim, k), pts, k, acc)
+        j = contact_jet(y, contact_kind(pts, k), pts, k, acc)
         if j.gap <= j.noise and j.rate <= vnoise and j.accel < 0:
             together[count] = k
             count += 1
@@ -450,7 +450,7 @@ def find_flight_event(
         )
         if res[HIT_K] >= 0:
             k = int(res[HIT_K])
-            kind = contact_kind(model, k)
+            kind = contact_kind(pts, k)
             s = polish_impact(y0, fc, g, kind, pts, k, s + res[HIT_DS], y)
             m = collect_together(y, model, pts, bounds, windowed, k, vnoise, together)
             return FlightEvent(EVENT_IMPACT, s, k, m, it)

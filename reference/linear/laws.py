@@ -1,5 +1,6 @@
 """The linear model past undecidable states, under the exact reference's impact laws
-(docs/laws.md; the exact core's counterpart is reference/continuation.py).
+(docs/laws.md; the registry reference.core.laws; the exact core resolves them inside its
+loop, reference.core.law_event).
 
 The linear kernel applies the paper's rule: where several contacts touch at an impact
 (two reached at once, an impact that would push a held contact, a contact at the ground
@@ -24,7 +25,7 @@ impact.  Under `moreau` or `sequential` the run goes on from there (`run_under_l
 4. a body landing flat (every contact in the impact, all leaving at one speed u⁺ > 0,
    0 < γ < 1) bounces flat for ever: the series is completed in closed form and the run
    ends at rest (`singularity`, all contacts down) at t + 2u⁺/(g(1 − γ))
-   (reference.continuation.flat_bounce_time);
+   (`bounce_series`);
 5. otherwise the kernel restarts from the state after the impact (its start closes the
    contacts left at zero normal velocity: the held-contact phases), with t_end,
    max_impacts and the energy floor kept those of the whole run.
@@ -40,25 +41,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..continuation import MAX_RESTARTS_AT_ONE_TIME
-from ..core.compliant import compliant_impulses, compliant_mass_impulses, work_size
 from ..core.impact_laws import (
-    LAW_COMPLIANT,
-    LAW_COMPLIANT_MASS,
-    LAW_MOREAU,
-    LAW_NAMES,
-    LAW_SEQUENTIAL,
     MAX_SEQUENTIAL_IMPACTS,
     NOT_SETTLED,
     SETTLED,
     SINGULAR,
     TOO_MANY,
-    moreau_impulses,
-    sequential_impulses,
 )
+from ..core.law_event import LAW_MAX_REPEATS as MAX_RESTARTS_AT_ONE_TIME
+from ..core.laws import LAW_PAPER, LAWS, law_code, law_of, resolving_laws, work_floats
+from ..core.records import LawWork
 from ..core.tolerances import EPS
 from ..trajectory import Status
 from . import kernel as K
+from .segment import LinearRun, run_message, run_segment
 
 # the fields of a LinearRun that have one entry per event row
 ROW_FIELDS = (
@@ -71,30 +67,23 @@ LEAVING_ULPS = 64.0
 
 
 def law_impulses(W, u_pre, gamma, law: int):
-    """(status, Λ, u⁺, single impacts) of `law` (LAW_MOREAU, LAW_COMPLIANT or LAW_SEQUENTIAL, the
-    fastest approach first) on k contacts of Delassus matrix W and normal velocities
-    u⁻: the exact core's law functions (reference.core.impact_laws), called as they are."""
+    """(status, Λ, u⁺, single impacts) of `law` (a code of the law registry,
+    reference.core.laws; the sequential law takes the fastest approach first) on k
+    contacts of Delassus matrix W and normal velocities u⁻: the exact core's law
+    functions, dispatched as the exact core dispatches them (law_dispatch.solve_law)."""
+    from ..core.law_dispatch import solve_law
+
+    if law == LAW_PAPER or law not in {x.code for x in LAWS}:
+        raise ValueError(f"no law function for law code {law}")
     k = len(u_pre)
     W = np.ascontiguousarray(W, dtype=float)
     u_pre = np.ascontiguousarray(u_pre, dtype=float)
     lam, u_post = np.zeros(k), np.zeros(k)
-    if law == LAW_MOREAU:
-        chol, vec = np.zeros((k, k)), np.zeros(2 * k)
-        active = np.zeros(k, dtype=np.int64)
-        status = moreau_impulses(W, u_pre, float(gamma), k, lam, u_post, chol, vec, active)
-        return int(status), lam, u_post, 1
-    if law == LAW_SEQUENTIAL:
-        order = np.zeros(0, dtype=np.int64)
-        status, hits = sequential_impulses(
-            W, u_pre, float(gamma), k, order, 0, lam, u_post, MAX_SEQUENTIAL_IMPACTS
-        )
-        return int(status), lam, u_post, int(hits)
-    if law in (LAW_COMPLIANT, LAW_COMPLIANT_MASS):
-        solve = compliant_impulses if law == LAW_COMPLIANT else compliant_mass_impulses
-        work, active = np.zeros(work_size(k)), np.zeros(k, dtype=np.int64)
-        status = solve(W, u_pre, float(gamma), k, lam, u_post, work, active)
-        return int(status), lam, u_post, 1
-    raise ValueError(f"no law function for {LAW_NAMES[law]!r}")
+    vec = np.zeros(work_floats(law_of(law), k))
+    work = LawWork(np.zeros((k, k)), vec, np.zeros(k, dtype=np.int64),
+                   np.zeros(0, dtype=np.int64), 0, MAX_SEQUENTIAL_IMPACTS)  # fmt: skip
+    status, hits = solve_law(law, W, u_pre, float(gamma), k, lam, u_post, work)
+    return int(status), lam, u_post, int(hits)
 
 
 def delassus(F, theta, contacts):
@@ -382,11 +371,11 @@ def run_under_law(
     """`simulate.run_linear` under `law` (`moreau` or `sequential`): kernel segments
     under the paper's rule, each undecidable stop resolved by the law and the kernel
     restarted after it (module docstring).  Returns one LinearRun over all segments."""
-    from .simulate import LinearRun, run_message, run_segment
 
-    law_id = LAW_NAMES.index(law)
-    if law_id not in (LAW_MOREAU, LAW_SEQUENTIAL, LAW_COMPLIANT, LAW_COMPLIANT_MASS):
-        raise ValueError(f"impact law must be one that resolves the impact here, got {law!r}")
+    resolving = [x.name for x in resolving_laws()]
+    if law not in resolving:
+        raise ValueError(f"impact law must be one of {', '.join(resolving)} here, got {law!r}")
+    law_id = law_code(law)
     F, theta, gamma = model.F, model.theta, model.restitution
     q, p = np.array(q0, dtype=float), np.array(p0, dtype=float)
     e_init = model.energy(q, p)

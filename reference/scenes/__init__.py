@@ -9,6 +9,12 @@ from pathlib import Path
 from ..scene import Scene, SceneError, load_scene_file, show_path
 
 
+def load_scene(path_or_name: str | Path) -> Scene:
+    """A scene from a file or the name of a built-in scene ("pentagon-bounce"),
+    validated (`resolve_scene`)."""
+    return resolve_scene(path_or_name)
+
+
 def builtin_dir() -> Path:
     return Path(str(resources.files(__name__)))
 
