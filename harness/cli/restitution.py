@@ -102,7 +102,7 @@ def run(args) -> int:
     plots = check_outputs(args, engines)
     total = sum(len(grid.cells(fixed)) for fixed in _fixed(engines))
     with progress_bar(total, "restitution", unit="impact") as bar:
-        doc = run_study(engines, grid, progress=log, tick=bar.update)
+        doc = run_study(engines, grid, progress=log, tick=bar.update, now=bar.set_postfix_str)
     attach(doc, args)
     write_outputs(args, doc, plots)
     emit(doc, args.json, format_restitution(doc))
