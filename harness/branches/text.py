@@ -46,14 +46,18 @@ def format_study(study) -> str:
     engine and dt, its distance to each outcome and the verdict."""
     if study.t_u is None:
         return f"{study.scene}: {study.message}"
-    lines = [
-        f"{study.scene}: first undecidable state at t_u = {study.t_u:.17g}, contacts "
-        f"{study.contacts}; engines start {study.lead:.3g} before it, measured "
-        f"{study.after:.3g} after it",
+    head = (
+        f"{study.scene}: first undecidable state at t_u = {study.t_u:.17g} s, contacts "
+        f"{study.contacts}; engines start {study.lead:.3g} a/U before it (a fixed-step "
+        f"engine half a step earlier still), measured {study.after:.3g} a/U after it"
+    )
+    outcomes = (
         "outcomes: "
         + "; ".join(f"({i + 1}) {o.name}" for i, o in enumerate(study.outcomes))
-        + f" (the nearest two {num(study.apart, '.3g')} apart)",
-    ]
+        + f" (the nearest two {num(study.apart, '.3g')} apart)"
+    )
+    lines = [*textwrap.wrap(head, WIDTH, subsequent_indent="  "),
+             *textwrap.wrap(outcomes, WIDTH, subsequent_indent="  ")]  # fmt: skip
     labels = sorted(((o.name, f"({i + 1})") for i, o in enumerate(study.outcomes)),
                     key=lambda kv: -len(kv[0]))  # fmt: skip
     rows = []
@@ -63,13 +67,13 @@ def format_study(study) -> str:
         for name, label in labels:
             text = text.replace(name, label)
         rows.append([r.engine, num(r.dt, "g"), *dist, text])
-    header = ["engine", "dt", *(f"({i + 1})" for i in range(len(study.outcomes))), "verdict"]
+    header = ["engine", "dt [s]", *(f"({i + 1})" for i in range(len(study.outcomes))), "verdict"]
     lines.append(table(rows, header, align="lr" + "r" * len(study.outcomes) + "l"))
     legend = (
         "(i): distance to outcome i after the impact: the norm of the velocity, angular "
         "velocity and contact normal velocity differences in units of max(sqrt(g a), "
-        "a/t_end); follows L: L 3 times nearer than any other and its distance falling "
-        "as dt falls (docs/laws.md)"
+        "a/t_end), U that unit; follows L: L 3 times nearer than any other and its distance "
+        "falling by half or more as dt falls tenfold (docs/laws.md)"
     )
     lines += textwrap.wrap(legend, WIDTH)
     return "\n".join(lines)
