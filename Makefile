@@ -14,21 +14,26 @@ STAMP_ALL := $(VENV)/.installed-all
 AOT    := $(VENV)/.aot
 CORE   := $(wildcard reference/core/*.py)
 
-.PHONY: setup demo test test-slow lint bench figures browser clean
+.PHONY: setup demo test test-slow lint bench figures docs-figures browser clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), sys.version' || { echo "need Python >= 3.11 (make PYTHON=/path/to/python3.11)"; exit 2; }
+	@echo "set-up 1/4: a virtual environment in $(VENV) (Python: $(PYTHON))"
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e .
+	@echo "set-up 2/4: pip, then the package and its core dependencies (numpy, numba, MuJoCo,"
+	@echo "  PyBullet, rerun, ...; the package's build compiles the reference's core, about 80 s)"
+	$(BIN)/pip install --progress-bar off --upgrade pip
+	$(BIN)/pip install --progress-bar off -e .
 	touch $(STAMP)
 
 # every extra ([all]: drake, dart, mjx, dask) and the dev tools
 $(STAMP_ALL): $(STAMP)
-	$(BIN)/pip install --quiet -e '.[all,dev]'
+	@echo "set-up 3/4: every extra (Drake, DART, MJX, dask) and the dev tools (2.5 GB in all)"
+	$(BIN)/pip install --progress-bar off -e '.[all,dev]'
 	touch $(STAMP_ALL)
 
 $(AOT): $(STAMP) $(CORE)
+	@echo "set-up 4/4: the reference's compiled core, rebuilt if its sources changed"
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)
 
@@ -41,10 +46,12 @@ demo: $(STAMP) $(AOT)
 	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
 		--record recordings/triangle-chatter.rrd --force
 
-# every engine's tests; an engine whose extra is missing has its tests skipped with the
-# reason, and under CI=true (.ci/run) such a skip fails the run (tests/conftest.py)
+# every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
+# engine whose extra is missing has its tests skipped with the reason, and under CI=true
+# (.ci/run) such a skip fails the run (tests/conftest.py)
+TEST_WORKERS ?= auto
 test: $(STAMP_ALL) $(AOT)
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(TEST_WORKERS)
 
 test-slow: $(STAMP_ALL) $(AOT)
 	$(BIN)/python -m pytest -m slow
@@ -54,6 +61,11 @@ lint: $(STAMP_ALL)
 
 bench: $(STAMP_ALL) $(AOT)
 	$(BIN)/python benchmarks/reference_speed.py
+
+# every figure the README and docs/api.md quote, re-measured and written between their
+# markers (tests/test_docs_figures.py checks the README's copies against the code)
+docs-figures: $(STAMP) $(AOT)
+	$(BIN)/python scripts/docs_figures.py
 
 figures: $(STAMP)
 	$(BIN)/harness figures --out out/figures --force

@@ -171,3 +171,22 @@ def _mjx(precision: str, name: str, doc: str) -> Callable:
 
 mjx = _mjx("float64", "mjx", "MJX (MuJoCo XLA) on JAX, float64: the mujoco model, diagexact off")
 mjx_f32 = _mjx("float32", "mjx_f32", "MJX (MuJoCo XLA) on JAX, float32: the mujoco model")
+
+# The entry points this package registers (pyproject.toml, group harness.engines), name →
+# attribute of this module: `harness.simulators` loads these names from here without
+# reading every installed distribution's metadata (start-up); tests/test_plugin_engine.py
+# checks that the two lists agree.
+BUILTIN_ENGINES = {
+    "reference": "reference",
+    "linear": "linear",
+    "mujoco": "mujoco",
+    "mujoco-default": "mujoco_default",
+    "pybullet": "pybullet",
+    "pybullet-default": "pybullet_default",
+    "drake": "drake",
+    "drake-continuous": "drake_continuous",
+    "dart": "dart",
+    "dart-default": "dart_default",
+    "mjx": "mjx",
+    "mjx-f32": "mjx_f32",
+}

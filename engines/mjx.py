@@ -82,21 +82,19 @@ def build_model(scene: Scene, dt: float):
     return spec.compile()
 
 
-def contact_slots(model, scene: Scene) -> np.ndarray:
+def contact_slots(model, scene: Scene, geoms: np.ndarray) -> np.ndarray:
     """Scene contact index of each of MJX's contact slots (−1 for a slot that is none of
-    the scene's contacts), from the geom pair MuJoCo C puts in each slot."""
+    the scene's contacts), from the geom pair of each slot (`geoms`, MJX's
+    `contact.geom`: fixed per slot, read from the data a compiled step returns, so no
+    eager, uncompiled MJX call is made)."""
     import mujoco
 
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
     name = {i: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, i) for i in range(model.ngeom)}
     index = {}
     for k, (g1, g2) in enumerate(contact_geom_pairs(scene)):
         index[frozenset((g1, g2))] = k
-    mjx = quiet_import("mujoco.mjx")
-    dx = mjx.forward(mjx.put_model(model), mjx.put_data(model, data))
-    geoms = np.asarray(dx.contact.geom)
-    return np.array([index.get(frozenset((name[a], name[b])), -1) for a, b in geoms])
+    pairs = np.asarray(geoms).reshape(-1, 2)
+    return np.array([index.get(frozenset((name.get(a), name.get(b))), -1) for a, b in pairs])
 
 
 @functools.cache
@@ -113,7 +111,7 @@ def _scan(precision: str, steps: int, batched: bool):
         def step(carry, _):
             nxt = mjx.step(m, carry)
             nxt = jax.tree_util.tree_map(lambda x, t: x.astype(t), nxt, dtypes)
-            forces = nxt._impl.efc_force[nxt.contact.efc_address]
+            forces = nxt._impl.efc_force[nxt._impl.contact.efc_address]
             return nxt, (nxt.qpos, nxt.qvel, forces)
 
         return jax.lax.scan(step, d, None, length=steps)
@@ -149,7 +147,7 @@ class _Stepper:
 
         self.scene, self.dt, self.precision = scene, dt, precision
         self.model = build_model(scene, dt)
-        self.slots = contact_slots(self.model, scene)
+        self.slots: np.ndarray | None = None  # from the first chunk's data
         self.y0 = initial_state(scene.initial)
         data = mujoco.MjData(self.model)
         qpos, qvel = to_mujoco_state(staggered_start(scene, self.y0, dt))
@@ -170,6 +168,8 @@ class _Stepper:
     def advance(self, steps: int) -> Rows:
         self.first = len(self.rows)
         self.dx, (qpos, qvel, f) = self._run(steps)
+        if self.slots is None:
+            self.slots = contact_slots(self.model, self.scene, self.dx._impl.contact.geom)
         states = from_mujoco_state(np.asarray(qpos, float), np.asarray(qvel, float))
         self.rows.extend(states)
         self.forces.extend(_per_contact(np.asarray(f, float), self.slots, self.scene.n_contacts))
@@ -303,7 +303,6 @@ def _run_group(scenes: list[Scene], dt: float, t_end: float, precision: str) -> 
     t_wall = time.perf_counter()
     scene0 = scenes[0]
     model = build_model(scene0, dt)
-    slots = contact_slots(model, scene0)
     mx = mjx.put_model(model)
     y0s = [initial_state(sc.initial) for sc in scenes]
     datas, rows0 = [], []
@@ -323,6 +322,8 @@ def _run_group(scenes: list[Scene], dt: float, t_end: float, precision: str) -> 
         compiled, seconds = compiled_scan(precision, steps, True, mx, dx)
         compile_s += seconds
         dx, (q, v, f) = compiled(mx, dx)
+        if done == 0:  # every scene of the group has the model's slots
+            slots = contact_slots(model, scene0, np.asarray(dx._impl.contact.geom)[0])
         qs.append(np.asarray(q, float))
         vs.append(np.asarray(v, float))
         fs.append(np.asarray(f, float))

@@ -62,12 +62,28 @@ def progress_bar(
         disable=not shown,
         mininterval=REFRESH_TERMINAL_S if sys.stderr.isatty() else REFRESH_FILE_S,
         smoothing=0.05,
-        dynamic_ncols=True,
+        ncols=bar_columns(),
+        bar_format=BAR_FORMAT,
     )
     loggers = [logging.getLogger(name) for name in LOGGERS]
     redirect = logging_redirect_tqdm(loggers=loggers) if shown else contextlib.nullcontext()
     with bar, redirect:
         yield bar
+
+
+# a bar of fixed width, so that a long "now running" text cannot squeeze it: the line is
+# cut at `bar_columns()` instead (tqdm trims a line to ncols)
+BAR_FORMAT = (
+    "{desc}: {percentage:3.0f}%|{bar:20}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]{postfix}"
+)
+WIDTH = 100
+
+
+def bar_columns() -> int:
+    """The progress line's width: the terminal's, at most WIDTH (100) columns."""
+    import shutil
+
+    return min(shutil.get_terminal_size((WIDTH, 24)).columns, WIDTH)
 
 
 class PlainProgress:
@@ -136,8 +152,12 @@ class PlainProgress:
         return text
 
     def write(self, line: str, file=None) -> None:
-        """tqdm.write's signature (callers pass file=sys.stderr: tqdm's default is stdout)."""
-        print(line, file=self.out or file or sys.stderr, flush=True)
+        """tqdm.write's signature (callers pass file=sys.stderr: tqdm's default is stdout);
+        a line longer than WIDTH is wrapped, its continuation indented."""
+        import textwrap
+
+        text = "\n".join(textwrap.wrap(line, WIDTH, subsequent_indent="  ")) or line
+        print(text, file=self.out or file or sys.stderr, flush=True)
 
     def close(self) -> None:
         """A last line (done, total time) when any line was printed."""

@@ -20,13 +20,9 @@ short description of the machine (no host name).
 
 from __future__ import annotations
 
-import datetime
 import os
-import platform
-import shlex
 import sys
 from collections.abc import Sequence
-from importlib import metadata
 from typing import Any
 
 PACKAGE = "euler-disk-harness"
@@ -40,6 +36,8 @@ def distribution_version(distribution: str | None) -> str | None:
     for no name, "not installed" when it is missing."""
     if distribution is None:
         return None
+    from importlib import metadata  # here: its import costs the command's start-up
+
     try:
         return metadata.version(distribution)
     except metadata.PackageNotFoundError:
@@ -70,6 +68,8 @@ def engine_versions() -> dict[str, str]:
 
 def versions() -> dict[str, str]:
     """Python, this package, the core numerical libraries and every engine's versions."""
+    import platform
+
     out = {"python": platform.python_version()}
     for dist in (PACKAGE, *CORE_DISTRIBUTIONS):
         out[dist] = distribution_version(dist) or "not installed"
@@ -79,6 +79,8 @@ def versions() -> dict[str, str]:
 
 def host_description() -> str:
     """'Linux 6.1.0 x86_64, 2 CPUs (model), 23.4 GiB' (what is known of it)."""
+    import platform
+
     parts = [f"{platform.system()} {platform.release()} {platform.machine()}".strip()]
     cpus = f"{os.cpu_count()} CPUs"
     model = _cpu_model()
@@ -97,6 +99,8 @@ def _cpu_model() -> str | None:
                     return line.split(":", 1)[1].strip()
     except OSError:
         pass
+    import platform
+
     return platform.processor() or None
 
 
@@ -110,12 +114,16 @@ def _memory_gib() -> float | None:
 def command_line(argv: Sequence[str] | None) -> str:
     """The command as one shell-quoted string: 'harness ' + the arguments (sys.argv[1:]
     when argv is None)."""
+    import shlex
+
     args = list(sys.argv[1:] if argv is None else argv)
     return shlex.join([PROGRAM, *args])
 
 
 def provenance(argv: Sequence[str] | None = None) -> dict[str, Any]:
     """The `provenance` object (module docstring) for a run started with `argv`."""
+    import datetime
+
     return {
         "command": command_line(argv),
         "versions": versions(),

@@ -8,7 +8,10 @@ its own engines the same way (pyproject.toml), so nothing here names an engine a
 engine installed from another package is used exactly like a built-in one
 (docs/engines.md).
 
-Discovery reads only the installed distributions' metadata; an entry point is loaded
+The names this package registers itself (engines.builtin.BUILTIN_ENGINES) are its
+built-in engines, loaded without reading any metadata (a plug-in cannot take one of
+these names).  Discovery reads only the installed distributions' metadata; an entry
+point is loaded
 (its module imported) when the engine is checked or run, so `harness simulate --engine
 reference` never imports MuJoCo, PyBullet or Drake.  An engine that is not installed, or
 whose entry point fails to load (import error, exception at import, not callable), is a
@@ -21,8 +24,9 @@ import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from importlib import metadata
 
+from engines import builtin
+from engines.builtin import BUILTIN_ENGINES
 from engines.interface import attribute
 from reference.checks import run_horizon
 from reference.scene import Scene, SceneError
@@ -66,6 +70,8 @@ def _check_library(name: str, obj: Callable) -> None:
     library, extra = attribute(obj, "library"), attribute(obj, "extra")
     if library is None or extra is None:
         return
+    from importlib import metadata  # here: its import costs every command's start-up
+
     try:
         metadata.version(library)
     except metadata.PackageNotFoundError:
@@ -76,8 +82,12 @@ def _check_library(name: str, obj: Callable) -> None:
 
 @functools.cache
 def _discovered() -> dict[str, EngineInfo]:
+    from importlib import metadata  # here: its import costs every command's start-up
+
     found: dict[str, EngineInfo] = {}
     for ep in metadata.entry_points(group=GROUP):
+        if ep.name in BUILTIN_ENGINES and ep.value != _builtin_target(ep.name):
+            continue  # another package's engine under a built-in name: not used
         dist = getattr(ep, "dist", None)
         package = dist.metadata["Name"] if dist is not None else None
         version = dist.version if dist is not None else None
@@ -86,13 +96,21 @@ def _discovered() -> dict[str, EngineInfo]:
     return found
 
 
+def _builtin_target(name: str) -> str:
+    return f"{builtin.__name__}:{BUILTIN_ENGINES[name]}"
+
+
 @functools.cache
 def _loaded(name: str) -> Callable:
+    if name in BUILTIN_ENGINES:  # this package's own: no metadata to read (start-up)
+        return getattr(builtin, BUILTIN_ENGINES[name])
     info = _discovered().get(name)
     if info is None:
         raise EngineLoadError(
             f"unknown engine {name!r}; installed: {', '.join(engine_names()) or 'none'}"
         )
+    from importlib import metadata
+
     ep = metadata.EntryPoint(name=name, value=info.target, group=GROUP)
     try:
         obj = ep.load()

@@ -3,20 +3,35 @@
 from __future__ import annotations
 
 import math
+import textwrap
+from collections.abc import Callable
 from typing import Any
 
 from reference.linear._text import table  # noqa: F401  (the one table formatter)
 from reference.trajectory import Trajectory
 
+WIDTH = 100
 
-def format_simulate(traj: Trajectory) -> str:
+
+def format_simulate(
+    traj: Trajectory,
+    scale: float | None = None,
+    wide: bool = False,
+    label: Callable[[int], str] = str,
+) -> str:
+    """The run's summary, one field a line; a long status is wrapped at WIDTH columns
+    (`wide`: on one line).  `scale`: the --scale the scene's initial state was scaled by;
+    `label`: a contact's name (v2, b1: GroundContacts.label)."""
     e = traj.energy
-    lines = [
-        f"engine      {traj.engine}",
-        f"scene       {traj.scene}",
-        f"status      {traj.status.value}: {traj.message}",
-        f"t_final     {traj.t_final:.17g}",
-    ]
+    lines = [f"engine      {traj.engine}", f"scene       {traj.scene}"]
+    if scale is not None:
+        lines.append(
+            f"scaled      by ε = {scale:g}: q × ε² = {scale * scale:g}, p × ε = {scale:g} "
+            "(the paper's scaling)"
+        )
+    status = f"status      {traj.status.value}: {traj.message}"
+    lines += [status] if wide else textwrap.wrap(status, WIDTH, subsequent_indent=" " * 12)
+    lines += [f"t_final     {traj.t_final:.17g}"]
     if traj.impact_law is not None:
         lines.append(f"impact law  {impact_law_text(traj.impact_law, traj.simultaneity_window)}")
     if traj.t_singularity is not None:
@@ -28,9 +43,17 @@ def format_simulate(traj: Trajectory) -> str:
         f"wall time   {traj.stats.get('wall_time_s', float('nan')):.3f} s",
     ]
     if traj.impacts:
-        lines.append("first impacts (t, contact, impulse):")
-        for ev in traj.impacts[:8]:
-            lines.append(f"  {ev.t:.15f}  {ev.contact:4d}  {ev.impulse:.6e}")
+        lines.append("first impacts:")
+        lines.append(
+            table(
+                [
+                    [f"{ev.t:.15f}", label(ev.contact), f"{ev.impulse:.6e}"]
+                    for ev in traj.impacts[:8]
+                ],
+                ["t [s]", "contact", "impulse"],
+                align="rrr",
+            )
+        )
     return "\n".join(lines)
 
 
@@ -45,11 +68,39 @@ def _simultaneous_text(traj: Trajectory) -> str:
 _BIDI = set(range(0x202A, 0x202F)) | set(range(0x2066, 0x206A))
 
 
-def terminal_safe(text: str) -> str:
+def terminal_safe(text: str, encoding: str | None = None) -> str:
     r"""`text` with every control character escaped (\x1b, \u202e, ...), except the line
     breaks and tabs of multi-line text: a name read from a file cannot move the cursor,
-    retitle the terminal or reorder a line (the CLI's every text output passes here)."""
-    return "".join(_escaped(ch) for ch in text)
+    retitle the terminal or reorder a line (the CLI's every text output passes here).
+    Symbols stdout's encoding (`encoding`) cannot show are spelled in ASCII (`ascii_text`)."""
+    safe = "".join(_escaped(ch) for ch in text)
+    return safe if _can_show(safe, encoding) else ascii_text(safe)
+
+
+# The symbols of the tables and their ASCII spellings, for a stdout that cannot show them.
+ASCII_SYMBOLS = {
+    "ρ": "rho", "γ": "gamma", "Δ": "Delta", "α": "alpha", "ε": "eps", "λ": "lambda",
+    "ψ": "psi", "β": "beta", "τ": "tau", "µ": "u", "μ": "u", "≈": "~", "±": "+-",
+    "–": "-", "—": "-", "−": "-", "×": "x", "·": "*", "²": "^2", "³": "^3", "≤": "<=",
+    "≥": ">=", "…": "...", "→": "->", "⁻": "-", "⁺": "+", "ᵢ": "_i", "√": "sqrt",
+}  # fmt: skip
+
+
+def ascii_text(text: str) -> str:
+    """`text` with ASCII_SYMBOLS spelled out and any other non-ASCII character as '?'."""
+    spelled = "".join(ASCII_SYMBOLS.get(ch, ch) for ch in text)
+    return spelled.encode("ascii", "replace").decode("ascii")
+
+
+def _can_show(text: str, encoding: str | None) -> bool:
+    import sys
+
+    encoding = encoding or getattr(sys.stdout, "encoding", None) or "utf-8"
+    try:
+        text.encode(encoding)
+    except (UnicodeEncodeError, LookupError):
+        return False
+    return True
 
 
 def _escaped(ch: str) -> str:

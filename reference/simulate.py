@@ -20,8 +20,6 @@ import numpy as np
 from . import compiled
 from .checks import check_reference_options, run_horizon
 from .core import records as R
-from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
-from .core.law_event import NO_PROGRESS
 from .core.laws import LAW_PAPER, law_code, law_of, work_floats
 from .core.records import (
     N_ACCUMULATIONS,
@@ -174,6 +172,8 @@ def law_contacts(scene: Scene) -> int:
     to MAX_LAW_CONTACTS."""
     if law_code(scene.impact_law) == LAW_PAPER:
         return 1
+    from .core.impact_laws import MAX_LAW_CONTACTS  # here: the core's modules import numba
+
     return min(scene.contacts.n, MAX_LAW_CONTACTS)
 
 
@@ -355,6 +355,10 @@ def _law_name(md) -> str:
 
 def _law_undecided(st, md, t, cs) -> str:
     """Why the run's impact law left a simultaneous impact undecided (law_event)."""
+    # here: the core's modules import numba (this runs only for such a run's message)
+    from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
+    from .core.law_event import NO_PROGRESS
+
     law = _law_name(md)
     outcome = int(st["law_outcome"])
     if outcome == NOT_SETTLED:
@@ -368,8 +372,9 @@ def _law_undecided(st, md, t, cs) -> str:
             "laws take (undecidable)")  # fmt: skip
 
 
-# One-sentence messages per loop status: (state, options, model, t, sorted info
-# contacts) → text, formatted only for the status a run ends with.
+# One-sentence messages per loop status: (state, options, model, t, the info contacts'
+# names) → text, formatted only for the status a run ends with.  Contacts are named as in
+# every table (v2: rim vertex 2, b1: bump 1; GroundContacts.label).
 _MESSAGES = {
     R.STATUS_T_END: lambda st, op, md, t, cs: f"reached t_end = {float(op['t_end']):g}",
     R.STATUS_SINGULARITY: lambda st, op, md, t, cs: f"all contacts down at t = {t:.17g}",
@@ -382,21 +387,19 @@ _MESSAGES = {
         "double precision; t_singularity extrapolated from the impact intervals"
     ),
     R.STATUS_AT_REST: lambda st, op, md, t, cs: (
-        f"at rest on contacts {cs} at t = {t:.17g}: the motion has ended"
+        f"at rest on {cs} at t = {t:.17g}: the motion has ended"
     ),
-    R.STATUS_SIMULTANEOUS: lambda st, op, md, t, cs: (
-        f"contacts {cs} hit simultaneously at t = {t:.17g}"
-    ),
+    R.STATUS_SIMULTANEOUS: lambda st, op, md, t, cs: f"{cs} hit simultaneously at t = {t:.17g}",
     R.STATUS_PUSHED: lambda st, op, md, t, cs: (
-        f"impact at contact {int(st['info_contact'])} at t = {t:.17g} would push "
-        f"resting contact(s) {cs} into the ground (undecidable)"
+        f"an impact at {md['label'](int(st['info_contact']))} at t = {t:.17g} would push "
+        f"{cs}, resting, into the ground (undecidable)"
     ),
     R.STATUS_MAX_IMPACTS: lambda st, op, md, t, cs: (
         f"reached max_impacts = {int(op['max_impacts'])}"
     ),
     R.STATUS_FAILED_NONFINITE: lambda st, op, md, t, cs: f"non-finite state at t = {t:.17g}",
     R.STATUS_OFF_FACE: lambda st, op, md, t, cs: (
-        f"bump {cs[0] if cs else -1} meets the face's plane outside its rim "
+        f"{cs or 'a bump'} meets the face's plane outside its rim "
         f"at t = {t:.17g}: the body has left the bumps (outside the three_point model)"
     ),
     R.STATUS_BELOW_FLOOR: lambda st, op, md, t, cs: (
@@ -410,7 +413,7 @@ _MESSAGES = {
         f"gamma))): at rest on all contacts at t = {float(st['t_hi']):.17g}"
     ),
     R.STATUS_FAILED_LCP: lambda st, op, md, t, cs: (
-        f"contact complementarity problem of contacts {cs} has no solution (at t = {t:.17g})"
+        f"contact complementarity problem of {cs} has no solution (at t = {t:.17g})"
     ),
     R.STATUS_FAILED_STUCK: lambda st, op, md, t, cs: (
         f"event search did not converge (at t = {t:.17g})"
@@ -419,7 +422,7 @@ _MESSAGES = {
         f"contact integration failed: step size below roundoff (at t = {t:.17g})"
     ),
     R.STATUS_FAILED_NO_ADVANCE: lambda st, op, md, t, cs: (
-        f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, with contacts {cs} held)"
+        f"contact phase cannot advance at t = {t:.17g} (chunk horizon 0, with {cs} held)"
     ),
     R.STATUS_STALLED: lambda st, op, md, t, cs: _stalled(st, op, md, t, cs),
 }
@@ -428,7 +431,7 @@ _MESSAGES = {
 def _stalled(st, op, md, t, cs) -> str:
     """Why the loop ended a run that stopped advancing (loop._stalled)."""
     law = _law_name(md)
-    held = f"contacts {cs} held" if cs else "no contact held"
+    held = f"{cs} held" if cs else "no contact held"
     return (
         f"the run stopped advancing at t = {t:.17g} ({held}, {law} law): {STALL_WINDOW} loop steps "
         f"without an impact advanced t by {float(st['stall_advance']):.3g} s, less than "
@@ -438,16 +441,22 @@ def _stalled(st, op, md, t, cs) -> str:
     )
 
 
-def status_message(state: np.void, opts: np.void, model: np.void) -> tuple[Status, str]:
+def status_message(
+    state: np.void, opts: np.void, model: np.void, label: Callable[[int], str] | None = None
+) -> tuple[Status, str]:
     """The Trajectory status and its one-sentence message for the loop's end state (the
-    run's options and model records)."""
+    run's options and model records; `label` names contact k, 'contact k' without it)."""
     code = int(state["status"])
     message = _MESSAGES.get(code)
     if message is None:
         return _STATUS.get(code, Status.FAILED), f"loop status {code}"
-    contacts = sorted(int(c) for c in state["info"][: int(state["n_info"])])
+    name = label or (lambda k: f"contact {k}")
+    contacts = ", ".join(
+        name(k) for k in sorted(int(c) for c in state["info"][: int(state["n_info"])])
+    )
     t = float(state["info_t"])
-    return _STATUS.get(code, Status.FAILED), message(state, opts, model, t, contacts)
+    fields = {field: model[field] for field in model.dtype.names} | {"label": name}
+    return _STATUS.get(code, Status.FAILED), message(state, opts, fields, t, contacts)
 
 
 def _trajectory(
@@ -461,7 +470,7 @@ def _trajectory(
         )
     ns, ni, nph, nacc = (int(c[i]) for i in (N_SAMPLES, N_IMPACTS, N_PHASES, N_ACCUMULATIONS))
     state = p.state[0]
-    status, message = status_message(state, p.options[0], p.model[0])
+    status, message = status_message(state, p.options[0], p.model[0], scene.contacts.label)
     t_sing = float(state["t_singularity"])
     stats = RunStats.from_counters(
         p.counters[0],

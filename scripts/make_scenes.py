@@ -91,7 +91,7 @@ def grazing() -> str:
     assert np.all(scene_contact_kinematics(scene, back)[0] > 0)
     return _toml(
         "grazing-contact",
-        f"triangle whose vertex 0 grazes the ground (double root) at t = {T_GRAZE}",
+        f"triangle whose vertex v0 grazes the ground (double root) at t = {T_GRAZE}",
         0.5,
         n,
         rho,
@@ -125,7 +125,7 @@ def near_simultaneous() -> str:
     assert abs((g[1] - g[0]) - DT_APART) < 1e-15 and g[0] == min(g)
     return _toml(
         "near-simultaneous",
-        "square falling without spin; vertices 0 and 1 hit about 1e-12 s apart",
+        "square falling without spin; vertices v0 and v1 hit about 1e-12 s apart",
         0.5,
         n,
         rho,
@@ -169,13 +169,13 @@ max_impacts = {s.run.max_impacts}
 
 BUMPY_SCENES = {
     "bumpy-transition": (
-        "100-gon (rho 0.5, gamma 0.5) rolling at tilt 0.02 over 3 bumps of 1e-4 m, "
-        "d = 0.1 m, g = 9.81: rim, mixed, bumps to the end",
+        "100-gon (ρ = 0.5, γ = 0.5) rolling at tilt 0.02 over 3 bumps of height Δ = 1e-4 m "
+        "at d = 0.1 m, g = 9.81: rim, mixed, bumps to the end",
         dict(delta=1e-4, tilt=0.02, n=100, t_end=1.0, max_impacts=1_000_000),
     ),
     "bumpy-rolling": (
-        "20-gon (rho 0.5, gamma 0) rolling at tilt 0.01 over 3 bumps of 1e-4 m, "
-        "d = 0.1 m: rim impacts, then the first bump impacts (short: for engines)",
+        "20-gon (ρ = 0.5, γ = 0) rolling at tilt 0.01 over 3 bumps of height Δ = 1e-4 m "
+        "at d = 0.1 m: rim impacts, then the first bump impacts (short: for engines)",
         dict(delta=1e-4, tilt=0.01, n=20, restitution=0.0, t_end=0.04, max_impacts=100_000),
     ),
 }

@@ -15,7 +15,8 @@ from harness import simulators
 from harness.branches import engines as E
 from harness.branches.suite import LANDINGS, landing
 from harness.cli import main
-from reference.geometry import scene_contact_kinematics
+from harness.horizon.state import flown
+from reference.geometry import initial_state, scene_contact_kinematics
 from reference.scene import velocity_unit
 
 ENGINE = """
@@ -93,6 +94,24 @@ def test_follows_needs_a_factor_three_and_a_distance_falling_with_dt():
     runs = [_run(1e-3, {"a": 0.1, "b": 0.9})]
     E.verdicts(runs)
     assert runs[0].verdict == "undecided"
+
+
+def test_a_distance_that_barely_falls_with_dt_is_not_following():
+    runs = [_run(1e-3, {"a": 0.072, "b": 0.9}), _run(1e-4, {"a": 0.054, "b": 0.9})]
+    E.verdicts(runs)
+    assert [r.verdict for r in runs] == ["none of the laws", "none of the laws"]
+
+
+def test_a_fixed_step_engine_meets_the_impact_mid_step():
+    scene = landing("landing-triangle-spin")
+    lead, dt = 0.02, 1e-3
+    y_u = initial_state(scene.initial)
+    y0, lead0 = E.start_before(scene, 0.0, y_u, lead)
+    y_dt, lead_dt = E.mid_step_start(scene, 0.0, y_u, y0, lead0, dt)
+    assert lead_dt == lead0 + 0.5 * dt
+    # its start is the common start carried back half a step by free flight
+    assert np.allclose(flown(scene, y_dt, 0.5 * dt), y0, rtol=0, atol=1e-14)
+    assert E.mid_step_start(scene, 0.0, y_u, y0, lead0, None) == (y0, lead0)
 
 
 @pytest.mark.parametrize("name", list(LANDINGS))

@@ -98,7 +98,7 @@ def test_bad_input_exits_2_with_one_line_and_no_traceback(tmp_path):
 def test_argument_errors_name_the_program_once_and_the_command(capsys):
     assert main(["nosuch"]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.startswith("harness: error: argument command: invalid choice: 'nosuch'")
+    assert err.startswith("harness: error: argument COMMAND: invalid choice: 'nosuch'")
     assert err.count("harness") == 1
     assert main(["simulate", "rod", "--dt", "-1"]) == 2
     assert capsys.readouterr().err.startswith("harness: error: simulate: argument --dt")

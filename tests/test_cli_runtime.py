@@ -143,3 +143,30 @@ def test_analyze_help_and_output_explain_the_columns(capsys, analysis, columns):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert all(c in out for c in columns)
+
+
+HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "tqdm", "rerun", "dask")
+
+
+def test_simulate_with_the_compiled_core_imports_no_heavy_library():
+    """Start-up: `harness simulate pentagon-bounce --json` with the ahead-of-time core
+    imports numpy and the package only (docs/performance.md)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from reference.compiled import fresh_aot_module
+
+    if fresh_aot_module() is None:
+        pytest.skip("no fresh ahead-of-time core (python -m reference.core.aot builds it)")
+    code = (
+        "import sys\n"
+        "from harness.cli import main\n"
+        "assert main(['simulate', 'pentagon-bounce', '--json']) == 0\n"
+        f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))\n"
+    )
+    root = Path(__file__).resolve().parent.parent
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=root
+    )
+    assert done.stdout.splitlines()[-1] == "[]"

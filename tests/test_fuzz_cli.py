@@ -12,6 +12,8 @@ and odd paths.  Whatever the input:
 Each example is bounded: the base scene runs 0.05 s with at most 200 impacts, and
 fixed-step engines always get --max-steps <= 20000.  The profile is derandomized (fixed
 examples, no example database), so every run of the suite checks the same inputs.
+Three tests (event-driven simulators, fixed-step engines, analyses and sweeps) share the
+examples, so that a parallel run (pytest-xdist) spreads them.
 """
 
 from __future__ import annotations
@@ -23,12 +25,15 @@ import os
 import tempfile
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from harness.cli import main
 
-EXAMPLES = 300
+# examples per test, 300 in all (the command mix of one test of 300 examples: simulate
+# 4/6, of which fixed-step engines 2/5; analyze and sweep 2/6)
+EXAMPLES = {"event-driven": 120, "fixed-step": 80, "analyses": 100}
 
 BASE = {
     "name": "fuzz",
@@ -169,10 +174,18 @@ ODD_PATHS = [
 ]
 
 
+# the simulators `simulate` fuzzes, in two groups (two tests: the suite runs them in
+# parallel): the event-driven ones and the fixed-step engines
+EVENT_DRIVEN = ("reference", "reference", "linear")
+FIXED_STEP = ("mujoco", "pybullet")
+
+
 @st.composite
-def command_lines(draw, hostile_ok: bool = True) -> list[str]:
+def command_lines(
+    draw, hostile_ok: bool = True, commands=("simulate",), engines=EVENT_DRIVEN
+) -> list[str]:
     numbers = number_text if hostile_ok else plausible.map(repr)
-    command = draw(st.sampled_from(["simulate"] * 4 + ["analyze", "sweep"]))
+    command = draw(st.sampled_from(commands))
     if command == "analyze":
         kind = draw(st.sampled_from(["selfsimilar", "chatter"]))
         argv = ["analyze", kind]
@@ -190,7 +203,7 @@ def command_lines(draw, hostile_ok: bool = True) -> list[str]:
             "--samples", draw(st.sampled_from(samples)), "--out", draw(st.sampled_from(outs)),
             "--workers", "1", "--json",
         ]  # fmt: skip
-    engine = draw(st.sampled_from(["reference", "reference", "linear", "mujoco", "pybullet"]))
+    engine = draw(st.sampled_from(engines))
     argv = ["simulate", "scene.toml", "--engine", engine, "--json"]
     if engine in ("mujoco", "pybullet"):
         steps = ["20000", "100", "0", "-5", "abc"] if hostile_ok else ["20000"]
@@ -207,11 +220,12 @@ def command_lines(draw, hostile_ok: bool = True) -> list[str]:
 
 
 @st.composite
-def cases(draw) -> tuple[str, list[str]]:
+def cases(draw, **commands) -> tuple[str, list[str]]:
     """(scene text, command line): a third of the cases careful (plausible values only,
-    so that runs happen and their output is checked), the rest anything."""
+    so that runs happen and their output is checked), the rest anything.  `commands`:
+    which commands and engines (command_lines)."""
     hostile_ok = draw(st.integers(0, 2)) > 0
-    return draw(scenes(hostile_ok)), draw(command_lines(hostile_ok))
+    return draw(scenes(hostile_ok)), draw(command_lines(hostile_ok, **commands))
 
 
 # ----------------------------------------------------------------------------- checks
@@ -239,15 +253,47 @@ def check_outputs(folder: Path, argv: list[str]) -> None:
         strict_json(pq.read_schema(part).metadata[b"summary"])
 
 
-@settings(
-    max_examples=EXAMPLES,
+FUZZ = settings(
     deadline=None,
     derandomize=True,
     database=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
 )
-@given(case=cases())
-def test_any_input_gives_a_result_or_one_clear_line(case, tmp_path, capfd):
+
+
+@pytest.fixture
+def no_sweep_figures(monkeypatch):
+    """The sweeps here skip their PNGs (2-3 s each, the bulk of this module's time):
+    what is fuzzed is the input; the README commands test draws a sweep's figures."""
+    import harness.sweep.plots
+
+    monkeypatch.setattr(harness.sweep.plots, "make_sweep_figures", lambda *a, **k: {})
+
+
+@settings(FUZZ, max_examples=EXAMPLES["event-driven"])
+@given(case=cases(commands=("simulate",), engines=EVENT_DRIVEN))
+def test_any_input_to_the_event_driven_simulators_gives_a_result_or_one_clear_line(
+    case, tmp_path, capfd
+):
+    check_case(case, tmp_path, capfd)
+
+
+@settings(FUZZ, max_examples=EXAMPLES["fixed-step"])
+@given(case=cases(commands=("simulate",), engines=FIXED_STEP))
+def test_any_input_to_the_engines_gives_a_result_or_one_clear_line(case, tmp_path, capfd):
+    check_case(case, tmp_path, capfd)
+
+
+@settings(FUZZ, max_examples=EXAMPLES["analyses"])
+@given(case=cases(commands=("analyze", "sweep")))
+def test_any_input_to_the_analyses_gives_a_result_or_one_clear_line(
+    case, tmp_path, capfd, no_sweep_figures
+):
+    check_case(case, tmp_path, capfd)
+
+
+def check_case(case, tmp_path, capfd) -> None:
+    """The checks of the module docstring on one (scene, command line)."""
     scene, argv = case
     folder = Path(tempfile.mkdtemp(dir=tmp_path))
     (folder / "scene.toml").write_text(scene, encoding="utf-8", errors="surrogatepass")

@@ -252,10 +252,11 @@ def test_compare_text_stays_within_100_columns_with_the_band_and_long_names():
     )
     text = format_compare(result)
     assert max(len(line) for line in text.splitlines()) <= 100
-    assert "15–22 in" in text  # the band kept, the cost left out
-    assert "matches 15–22 (10–90 %, 24 grid phases), within it" in text
-    run.engine = "mujoco"
-    assert "15–22 in" in format_compare(result)
+    row = next(line for line in text.splitlines()[::-1] if line.startswith("pybullet-default"))
+    assert row.split()[-5:] == ["22", "15–22", "yes", "1.0e-04", "12–30"]  # the horizon table
+    assert "matches 22 impacts, at least the 15 that 90 % of the exact model's runs" in text
+    run.horizon = replace(run.horizon, matched=14)
+    assert "matches 14 impacts, fewer than the 15" in format_compare(result)
 
 
 def test_profile_prediction_from_the_deep_ensemble_matches_the_shallow_one(elastic):

@@ -231,7 +231,7 @@ def test_the_built_in_near_simultaneous_hits_are_one_impact_under_the_default_wi
         scene, options=ReferenceOptions(simultaneity_window=DEFAULT_SIMULTANEITY_WINDOW)
     )
     assert traj.status.value == "simultaneous_impact"
-    assert "[0, 1]" in traj.message and traj.impacts == []
+    assert "v0, v1 hit simultaneously" in traj.message and traj.impacts == []
 
 
 @pytest.mark.parametrize("sample", [0, 1, 2, 3])

@@ -70,3 +70,30 @@ def test_chatter_without_self_similar_pairs_explains_no_table(capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "beta_p" not in out and "spectral radius" not in out and "CC" in out
+
+
+def test_symbols_are_spelled_in_ascii_where_stdout_cannot_show_them():
+    from harness.text import terminal_safe
+
+    text = "ρ = 0.3, γ = 0.5, Δ/a ≈ 2e-3, ε² – 1"
+    assert terminal_safe(text, "utf-8") == text
+    assert terminal_safe(text, "ascii") == "rho = 0.3, gamma = 0.5, Delta/a ~ 2e-3, eps^2 - 1"
+
+
+def test_simulate_says_it_was_scaled_and_names_both_files_it_writes(tmp_path, capsys):
+    out = tmp_path / "run.parquet"
+    assert main(["simulate", "pentagon-bounce", "--scale", "1e-4", "--out", str(out)]) == 0
+    stdout, stderr = capsys.readouterr()
+    assert "scaled      by ε = 0.0001: q × ε² = 1e-08, p × ε = 0.0001" in stdout
+    assert f"wrote {out} (samples) and {tmp_path / 'run.impacts.parquet'} (impacts)" in stderr
+
+
+def test_branches_names_contacts_as_the_tables_do(capsys):
+    import re
+
+    assert main(["branches", "triangle-chatter"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"t_u = \S+ s, contacts v\d, v\d\n", out), out
+    moreau = next(line for line in out.splitlines() if line.startswith("moreau "))
+    assert re.search(r" v\d v\d .* v\d \+\S+ s ", moreau), moreau
+    assert max(len(line) for line in out.splitlines()) <= 100

@@ -203,3 +203,22 @@ def test_restitution_runs_each_dt_and_phase_as_one_batch(batching):
     assert batching.CALLS == [2, 2, 2]  # three onset phases, two gammas each
     plain = run_study(["mujoco"], grid)["engines"][0]["rows"]
     assert [r["e_eff"] for r in rows] == [r["e_eff"] for r in plain]
+
+
+def test_the_builtin_engines_loaded_without_metadata_are_the_ones_pyproject_registers():
+    import tomllib
+
+    from engines.builtin import BUILTIN_ENGINES
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    registered = project["project"]["entry-points"]["harness.engines"]
+    assert registered == {name: f"engines.builtin:{a}" for name, a in BUILTIN_ENGINES.items()}
+
+
+def test_a_plugin_cannot_take_a_builtin_name(plugins, monkeypatch):
+    _dist_info(plugins / "more", "impostor", "1.0", "reference = toy_engine:simulate")
+    monkeypatch.syspath_prepend(str(plugins / "more"))  # found first
+    simulators.refresh()
+    info = {i.name: i for i in simulators.engine_infos()}["reference"]
+    assert info.target == "engines.builtin:reference"
+    assert simulators.load_engine("reference").__module__ == "engines.builtin"

@@ -71,3 +71,21 @@ def test_a_long_fixed_step_run_off_a_terminal_gets_plain_lines():
     progress(30, 100)
     assert isinstance(progress.bar, PlainProgress) and progress.bar.n == 30
     progress.close()
+
+
+def test_a_bar_with_a_long_text_keeps_its_width_and_stays_within_100_columns():
+    import io
+    import re
+
+    from tqdm import tqdm
+
+    from harness.progress import BAR_FORMAT
+
+    out = io.StringIO()
+    bar = tqdm(total=80, desc="stress", ncols=100, bar_format=BAR_FORMAT, file=out)
+    bar.update(40)
+    bar.set_postfix_str("alpha-1e-12: drake-continuous, predicted 4.4 s, hard cap 60 s " * 3)
+    line = str(bar)
+    bar.close()
+    assert len(line) <= 100
+    assert re.search(r"\|[#█]{10} {10}\|", line), line  # 20 characters, half full

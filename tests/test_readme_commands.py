@@ -19,6 +19,7 @@ from harness.cli import main
 README = Path(__file__).resolve().parent.parent / "README.md"
 HARNESS = re.compile(r"^(?:\S*/)?harness\s+")
 OUTPUT_OPTIONS = ("--out", "--plot", "--record")
+WIDTH = 100  # columns every command's default output fits
 
 # subcommand -> {option: values}: small settings for the slow commands (seconds, not
 # minutes), replacing the README's values of these options.
@@ -28,6 +29,8 @@ SMALL: dict[str, dict[str, list[str]]] = {
     "stress": {"--engine": ["mujoco"], "--case": ["grazing"]},
     "fidelity": {"--engine": ["mujoco"], "--dt": ["1e-3"], "--eps-grid": ["1:0.01:3"]},
     "sweep": {"--gyration": ["0.3:0.6:2"], "--restitution": ["0.2:0.4:2"], "--samples": ["5"]},
+    # one figure (tests/test_paper_figures.py draws each of them)
+    "figures": {"--only": ["rod_clin"]},
     "restitution": {
         "--engine": ["mujoco"],
         "--gamma": ["0.8"],
@@ -81,17 +84,22 @@ def test_readme_lists_the_commands():
     assert {"simulate", "compare", "bench", "report"} <= set(names)
 
 
-def test_readme_commands_run_in_order(tmp_path, monkeypatch, capsys):
+def test_readme_commands_run_in_order_and_print_within_100_columns(tmp_path, monkeypatch, capsys):
+    """Each command exits 0, writes what it names, and every line it prints (stdout and
+    stderr, progress lines included) is at most WIDTH characters."""
     monkeypatch.chdir(tmp_path)
     for line in readme_commands():
         argv = with_small_settings(shlex.split(HARNESS.sub("", line)))
         for path in path_inputs(argv):
             assert Path(path).exists(), f"README: `{line}` reads {path}, not written above"
         rc = main(argv)
-        err = capsys.readouterr().err
+        out, err = capsys.readouterr()
         assert rc == 0, f"README: `{line}` exited {rc}: {err.strip()[-400:]}"
         for path in outputs(argv):
             assert Path(path).exists(), f"README: `{line}` did not write {path}"
+        if "--json" not in argv:
+            wide = [x for x in (out + err).splitlines() if len(x) > WIDTH]
+            assert not wide, f"README: `{line}` prints lines over {WIDTH} columns: {wide}"
 
 
 @pytest.mark.parametrize(

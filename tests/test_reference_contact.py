@@ -143,7 +143,7 @@ def test_gamma_zero_heavy_rim_triangle_reaches_the_singularity():
     )
     assert windowed.status.value == "simultaneous_impact"
     assert windowed.t_final == pytest.approx(pair[0].t, abs=1e-12)
-    assert f"[{min(pair[0].contact, pair[1].contact)}, " in windowed.message
+    assert f"v{min(pair[0].contact, pair[1].contact)}, " in windowed.message
     assert traj.t_singularity is not None and traj.t_singularity > traj.impacts[-1].t - 1e-9
 
 

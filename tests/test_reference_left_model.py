@@ -38,7 +38,8 @@ def _distance_in_face(state, k):
 
 
 def _named_bump(message):
-    return int(message.split()[1])
+    """k of the message's 'bk meets the face's plane ...'."""
+    return int(message.split()[0].removeprefix("b"))
 
 
 def test_an_elastic_disk_bouncing_off_its_bumps_ends_left_model():

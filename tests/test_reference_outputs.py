@@ -117,7 +117,9 @@ def test_every_loop_status_ends_with_its_status_and_its_own_message():
         messages.add(message)
     assert len(messages) == len(codes)
     state["status"] = R.STATUS_SIMULTANEOUS
-    assert status_message(state, opts, model)[1] == "contacts [2] hit simultaneously at t = 0.125"
+    assert status_message(state, opts, model)[1] == "contact 2 hit simultaneously at t = 0.125"
+    text = status_message(state, opts, model, label=lambda k: f"v{k}")[1]
+    assert text == "v2 hit simultaneously at t = 0.125"
     state["status"] = R.STATUS_LAW_UNDECIDED  # one sentence per way a law leaves it
     said = set()
     for outcome in range(1, 5):  # NOT_SETTLED, SINGULAR, TOO_MANY, law_event.NO_PROGRESS

@@ -14,6 +14,7 @@ import pytest
 from harness.cli import main
 from harness.report.links import file_href, link_problem
 from harness.text import terminal_safe
+from reference.scene import show_path
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +98,7 @@ def test_a_bom_json_is_read_and_a_fifo_is_named(tmp_path, capsys, compare_doc):
     os.mkfifo(fifo)
     assert main(["report", str(fifo), "--out", str(tmp_path / "f.html")]) == 2
     assert capsys.readouterr().err.strip() == (
-        f"harness: error: {fifo}: a FIFO (named pipe), not a regular file"
+        f"harness: error: {show_path(fifo)}: a FIFO (named pipe), not a regular file"
     )
 
 

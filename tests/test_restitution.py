@@ -156,3 +156,13 @@ def test_report_has_a_restitution_section_with_escaped_text(tmp_path):
     assert "&lt;b&gt;damper&lt;/b&gt; &amp; co" in html and "<b>damper" not in html
     assert "data:image/png;base64," in html
     assert "simultaneous_impact" in html  # the reference's edge, shown as such
+
+
+def test_the_study_names_each_engine_as_it_starts():
+    """The progress line's "now" is the engine being run (the default runs every
+    installed fixed-step engine, some of them slow)."""
+    seen, ticks = [], []
+    grid = Grid(gammas=(0.5,), speeds=(1.0,), dts=(1e-3,), geometries=("vertex",), phases=(0.5,))
+    run_study(["reference", "mujoco"], grid, tick=ticks.append, now=seen.append)
+    assert seen == ["reference", "mujoco"]
+    assert len(ticks) == len(grid.cells(False)) + len(grid.cells(True))

@@ -51,7 +51,7 @@ def document():
 def test_default_report_fits_100_columns_with_a_legend():
     text = format_stress(document())
     assert max(len(line) for line in text.splitlines()) <= 100
-    assert "FAIL (failed)" in text and "n/a:" in text  # the legend
+    assert "FAILED: NaN" in text and "n/a:" in text  # the legend
 
 
 def test_matrix_has_one_row_per_case_and_a_column_per_simulator():

@@ -29,31 +29,33 @@ def _short(x: float | None) -> str:
     return f"{mantissa}e{int(exp)}"
 
 
-def setting_text(row: dict[str, Any], wide: bool) -> str:
-    if wide or (row["dt"] is None and row["contact_rtol"] is None):
-        return row["setting"]
-    if row["dt"] is not None:
-        return f"dt {_short(row['dt'])}"
-    return f"rtol {_short(row['contact_rtol'])} ch {_short(row['chatter_tol'])}"
+def setting_columns(row: dict[str, Any], wide: bool) -> list[str]:
+    """dt [s] and the reference's contact_rtol ('-' where the setting has none); --wide:
+    the setting's own label (with chatter_tol)."""
+    if wide:
+        return [row["setting"]]
+    return [_short(row["dt"]), _short(row["contact_rtol"])]
 
 
-def matched_text(row: dict[str, Any]) -> str:
-    """k/N, marked '*' when the run does not follow the reference."""
-    mark = "" if row.get("follows_reference", True) else "*"
-    return f"{row['impacts_matched']}/{row['reference_impacts']}{mark}"
+def match_columns(row: dict[str, Any]) -> list[str]:
+    """matched, of, follows ('yes' / 'no')."""
+    follows = "yes" if row.get("follows_reference", True) else "no"
+    return [str(row["impacts_matched"]), str(row["reference_impacts"]), follows]
 
 
 def results_table(doc: dict[str, Any], wide: bool) -> str:
-    header = ["engine", "setting", "status", "time[s]"]
-    header += ["min[s]"] if wide else []
-    header += ["matched", "t_err[s]", "E_err", "E_err<div"]
-    header += ["att<div", "diverges[s]"] if wide else []
+    header = ["engine"] + (["setting"] if wide else ["dt [s]", "rtol"])
+    header += ["status", "time [s]"]
+    header += ["min [s]"] if wide else []
+    header += ["matched", "of", "follows", "t_err [s]"]
+    header += ["E_err", "E_err<div", "att<div", "diverges [s]"] if wide else ["E_err<div"]
     rows = []
     for r in doc["results"]:
         status = r["status"] if wide else SHORT_STATUS.get(r["status"], r["status"])
-        row = [r["engine"], setting_text(r, wide), status, _fmt(r["wall_time_s"], ".3g")]
+        row = [r["engine"], *setting_columns(r, wide), status, _fmt(r["wall_time_s"], ".3g")]
         row += [_fmt(r["wall_time_min_s"], ".3g")] if wide else []
-        row += [matched_text(r), _fmt(r["impact_time_error"]), _fmt(r["energy_error"])]
+        row += [*match_columns(r), _fmt(r["impact_time_error"])]
+        row += [_fmt(r["energy_error"])] if wide else []
         row += [_fmt(r["energy_error_agreeing"])]
         if wide:
             row += [
@@ -61,20 +63,35 @@ def results_table(doc: dict[str, Any], wide: bool) -> str:
                 _fmt(r.get("first_divergence_time"), ".4g"),
             ]
         rows.append(row)
-    return table(rows, header, align="lll" + "r" * (len(header) - 3))
+    left = 2 if wide else 3
+    return table(rows, header, align="l" * left + "l" + "r" * (len(header) - left - 1))
 
 
-LEGEND = f"""\
-matched    k/N: the first k of the reference's N impacts the run reproduces in order (same
-           contact, time within the window); N counts the reference's impacts up to the
-           earlier end of the two runs, so a run that fails or stops early has a small N
-           * the run does not follow the reference (fewer than {MATCH_FRACTION:.0%} of its first
-           {LEADING_IMPACTS} impacts matched): left out of the summary below
-t_err      max |t - t_ref| over the matched impacts [s]
-E_err      max |E - E_ref| / E_ref(0) over the common window; E_err<div: up to the divergence
-setting    dt: fixed timestep [s]; rtol R ch C: the reference's contact_rtol and chatter_tol
-time       median wall time of one run [s] (--wide: and the fastest)
-(docs/output.md defines every column; --wide: every column, --json: every number)"""
+LEGEND = "\n".join(
+    [
+        "dt         fixed timestep [s]; rtol: the reference's contact_rtol (--wide: with its",
+        "           chatter_tol)",
+        "matched    the first k of the reference's impacts the run reproduces in order (same",
+        "           contact, time within the window), of the reference's impacts up to the",
+        "           earlier end of the two runs (a run that fails or stops early has a small `of`)",
+        f"follows    yes: at least {MATCH_FRACTION:.0%} of the first {LEADING_IMPACTS} impacts "
+        "matched; the runs that",
+        "           do not follow the reference are left out of the summary below",
+        "t_err      max |t - t_ref| over the matched impacts [s]",
+        "E_err<div  max |E - E_ref| / E_ref(0) up to the divergence (--wide: also E_err, over",
+        "           the common window)",
+        "time       median wall time of one run [s] (--wide: and the fastest)",
+        "(docs/output.md defines every column; --wide: every column, --json: every number)",
+    ]
+)
+
+
+# the summary's metrics in words (the JSON keeps the keys)
+METRIC_NAMES = {
+    "energy_error_agreeing": "energy error while the run follows the reference (E_err<div)",
+    "energy_error": "energy error over the common window (E_err)",
+    "impact_time_error": "impact time error [s] (t_err)",
+}
 
 
 def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
@@ -85,7 +102,7 @@ def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
     lines = [
         "summary (runs that follow the reference only): best error, its cost, and that cost "
         "over the",
-        "reference's cost at the same accuracy ('>=': a lower bound, '<=': an upper bound)",
+        "reference's cost at the same accuracy (≥: a lower bound, ≤: an upper bound)",
     ]
     for metric, per in derived.items():
         rows = []
@@ -94,16 +111,13 @@ def summary_lines(doc: dict[str, Any], wide: bool) -> list[str]:
             if d is None:
                 rows.append([engine, "-", "-", "no run follows the reference"])
                 continue
-            bound = {"lower": ">=", "upper": "<="}.get(d["cost_ratio_bound"], "")
+            bound = {"lower": "≥ ", "upper": "≤ "}.get(d["cost_ratio_bound"], "")
             ratio = _fmt(d["cost_ratio"], ".3g")
             rows.append(
-                [engine, _fmt(d["best_error"]), f"{d['best_error_cost_s']:.3g}", f"{bound}{ratio}x"]
+                [engine, _fmt(d["best_error"]), f"{d['best_error_cost_s']:.3g}", f"{bound}{ratio}"]
             )
-        lines += [
-            "",
-            f"{metric}:",
-            table(rows, ["simulator", "best", "cost[s]", "x reference"], align="lrrl"),
-        ]
+        header = ["simulator", "best error", "its cost [s]", "cost / reference's"]
+        lines += ["", f"{METRIC_NAMES.get(metric, metric)}:", table(rows, header, align="lrrl")]
     return lines
 
 

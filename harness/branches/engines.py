@@ -6,7 +6,11 @@ The reference runs the scene under the paper's rule to its first undecidable sta
 state a short lead before it, at t_u − lead (the reference's own state there; for a
 scene that starts on the undecidable state, y_u carried back by free flight, or y_u
 itself when a touching contact separates and would be below the ground earlier), and
-runs through the impact to t_m = t_u + after.  Each branch (every law of
+runs through the impact to t_m = t_u + after.  A fixed-step engine starts half a step
+earlier still (at t_u − lead − dt/2, measured at t_m − dt/2 against the branches there):
+the start is a whole number of steps before t_u otherwise, and an impact exactly on a
+step boundary is a coincidence of the set-up that decides which contact a stepped
+engine meets first; mid-step is the generic case.  Each branch (every law of
 reference.scene.IMPACT_LAWS but `paper`, and the sequential law in every order of the
 contacts, harness.branches.spread) is the exact reference from the scene's start to
 t_m.  Branches whose states at t_m coincide are one outcome (named together).
@@ -18,9 +22,9 @@ impact): its velocities and the post-impact normal velocities.
 
 Verdict per engine and dt:
 - `follows L`: L is nearer than every other outcome by FOLLOW_FACTOR (3) or more, and
-  the distance to L falls as dt falls (against the next larger dt; at the largest dt
-  against the next smaller one), or is at roundoff (≤ EXACT_DISTANCE: an event-driven
-  engine that is an exact law);
+  the distance to L falls as dt falls (to FALL_FRACTION of it or less, against the next
+  larger dt; at the largest dt against the next smaller one), or is at roundoff
+  (≤ EXACT_DISTANCE: an event-driven engine that is an exact law);
 - `between L and M`: the two nearest outcomes are within FOLLOW_FACTOR of each other;
 - `none of the laws`: L is clearly nearest but its distance does not fall with dt, or
   it is farther than FAR_DISTANCE;
@@ -47,6 +51,10 @@ LEAD = 0.02  # the engines start this long (in a/U) before t_u
 AFTER = 0.1  # and measured at most this long after it (half the gap to the next impact)
 AFTER_MIN = 0.02  # but at least this long after it
 EXACT_DISTANCE = 1e-9
+# "falls with dt": at the next smaller dt the distance is at most this fraction of it (a
+# first-order method gives 1/10 per decade; a bare decrease would count roundoff-level
+# changes of an engine that has reached its own floor)
+FALL_FRACTION = 0.5
 FAR_DISTANCE = 0.5
 SAME_OUTCOME = 1e-9  # branches closer than this (dimensionless) are one outcome
 LAWS = ("moreau", "sequential", "compliant", "compliant-mass")
@@ -155,6 +163,16 @@ def start_before(scene, t_u: float, y_u: np.ndarray, lead: float) -> tuple[np.nd
     return y0, lead
 
 
+def mid_step_start(scene, t_u: float, y_u, y0, lead: float, dt: float | None):
+    """(start state, its lead) of an engine at step dt: half a step before the common
+    start, so that t_u lies mid-step on the engine's grid (module docstring); the common
+    start for an event-driven engine, or where no earlier state exists."""
+    if dt is None:
+        return y0, lead
+    y, shifted = start_before(scene, t_u, y_u, lead + 0.5 * dt)
+    return (y, shifted) if shifted == lead + 0.5 * dt else (y0, lead)
+
+
 def branch_list(contacts: list[int]) -> list[tuple[str, str, tuple[int, ...] | None]]:
     """(name, law, order) of every branch: each law, the sequential law in each order."""
     return [(law, law, None) for law in LAWS] + ordered_runs(contacts)
@@ -250,7 +268,8 @@ def verdict(r: EngineAtImpact, neighbour: EngineAtImpact | None) -> tuple[str, s
     if neighbour is None or neighbour.dt is None or r.dt is None:
         return "undecided", f"nearest {best} ({d_best:.3g}); one dt: no trend measured"
     d_other = neighbour.distances.get(best, math.inf)
-    falls = d_best < d_other if r.dt < neighbour.dt else d_other < d_best
+    smaller, larger = (d_best, d_other) if r.dt < neighbour.dt else (d_other, d_best)
+    falls = smaller <= FALL_FRACTION * larger
     if falls:
         return f"follows {best}", f"{d_best:.3g}, falling with dt"
     return "none of the laws", f"nearest {best} ({d_best:.3g}) but not falling with dt"
@@ -272,14 +291,29 @@ def study(scene, engines: list[str], dts: list[float | None], t_end: float | Non
     outcomes = outcomes_at(scene, t_u + after, contacts)
     apart = min((distance(scene, a.state, b.state, contacts) for i, a in enumerate(outcomes)
                  for b in outcomes[i + 1 :]), default=math.inf)  # fmt: skip
+    starts: dict[float | None, tuple] = {}
     runs = []
     for engine in engines:
         for dt in _engine_dts(engine, dts):
             if progress:
                 progress(f"branches: {engine} dt={dt}")
-            runs.append(run_engine(engine, scene, y0, duration, dt, contacts, outcomes))
+            if dt not in starts:
+                starts[dt] = engine_start(scene, t_u, y_u, y0, lead, after, dt, contacts)
+            y_dt, outcomes_dt = starts[dt] if starts[dt][1] is not None else (y0, outcomes)
+            runs.append(run_engine(engine, scene, y_dt, duration, dt, contacts, outcomes_dt))
     verdicts(runs)
     return ImpactStudy(scene.name, t_u, contacts, lead, after, outcomes, runs, apart=apart)
+
+
+def engine_start(scene, t_u, y_u, y0, lead, after, dt, contacts) -> tuple:
+    """(start state, outcomes at its measuring time) for an engine at step dt: from
+    `mid_step_start`, with the branches' states at t_u + after − the extra lead (None
+    when the start is the common one, whose outcomes the study has)."""
+    y_dt, lead_dt = mid_step_start(scene, t_u, y_u, y0, lead, dt)
+    shift = lead_dt - lead
+    if shift == 0.0:
+        return y0, None
+    return y_dt, outcomes_at(scene, t_u + after - shift, contacts)
 
 
 def _engine_dts(engine: str, dts: list[float | None]) -> list[float | None]:

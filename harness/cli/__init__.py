@@ -64,18 +64,62 @@ COMMANDS = (
 )
 
 
-def build_parser() -> Parser:
+def build_parser(argv: list[str] | None = None) -> Parser:
+    """The command line's parser.  With `argv`, only the command it names is built in
+    full; every other one is its name and help (enough for `harness --help` and for
+    argparse to name the choices), so that a command's start-up does not import the
+    modules behind the other commands' options and defaults."""
     p = Parser(prog=PROGRAM, description=__doc__.splitlines()[0])
-    p.add_argument(
-        "--version", action="version", version=f"{PROGRAM} {distribution_version(PACKAGE)}"
-    )
+    p.add_argument("--version", action=VersionAction)
     add_verbose(p, top=True)
-    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser, metavar="COMMAND")
+    wanted = _command_named(argv)
     for command in COMMANDS:
-        command.register(sub)
+        try:
+            command.register(_Only(sub, wanted))
+        except _Listed:
+            pass
     for parser in _subparsers(p):
         add_verbose(parser)
     return p
+
+
+class VersionAction(argparse.Action):
+    """--version: prints 'harness X.Y.Z' (the installed distribution's version, looked up
+    only when asked) and exits."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, **kwargs):
+        kwargs.setdefault("help", "show the program's version and exit")
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"{PROGRAM} {distribution_version(PACKAGE)}")
+        parser.exit()
+
+
+class _Listed(Exception):
+    """A command registered by name and help only (build_parser)."""
+
+
+class _Only:
+    """The sub-command action `register` sees: the command `wanted` (every one when None)
+    is added in full, any other one by its name and help, after which its `register`
+    stops (_Listed)."""
+
+    def __init__(self, sub, wanted: str | None) -> None:
+        self.sub, self.wanted = sub, wanted
+
+    def add_parser(self, name: str, **kwargs):
+        if self.wanted is None or name == self.wanted:
+            return self.sub.add_parser(name, **kwargs)
+        self.sub.add_parser(name, help=kwargs.get("help"))
+        raise _Listed
+
+
+def _command_named(argv: list[str] | None) -> str | None:
+    """The command argv names (its first word that is not an option), None without one."""
+    words = [a for a in argv or [] if not a.startswith("-")]
+    return words[0] if words else None
 
 
 def _subparsers(parser: argparse.ArgumentParser) -> list[argparse.ArgumentParser]:
@@ -150,7 +194,7 @@ def _signal_status(code: int) -> int:
 def _main(argv: list[str] | None) -> int:
     try:
         argv = list(sys.argv[1:] if argv is None else argv)
-        args = build_parser().parse_args(argv)
+        args = build_parser(argv).parse_args(argv)
         args.argv = argv  # the exact command, for the results' provenance
         configure_logging(args.verbose)
         code = args.func(args)

@@ -18,10 +18,10 @@ ANALYSES = {
 
 
 def register(sub) -> None:
+    a = sub.add_parser("analyze", help="analyses of the linearised model")
     from reference.linear._text import CHATTER_LEGEND, SELFSIMILAR_LEGEND
 
     legends = {"selfsimilar": SELFSIMILAR_LEGEND, "chatter": CHATTER_LEGEND}
-    a = sub.add_parser("analyze", help="analyses of the linearised model")
     asub = a.add_subparsers(dest="analysis", required=True, parser_class=Parser)
     for name, (text, n_min) in ANALYSES.items():
         x = asub.add_parser(name, help=text, description=text, epilog=legends[name])

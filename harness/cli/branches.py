@@ -84,7 +84,7 @@ def run_spread(args) -> int:
             plot_spread(spread, tmp)
         doc["plot"] = str(args.plot)
         note(f"wrote {args.plot}")
-    emit(doc, args.json, format_spread(spread))
+    emit(doc, args.json, format_spread(spread, label=scene.contacts.label))
     return 0
 
 

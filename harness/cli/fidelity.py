@@ -22,13 +22,13 @@ from .common import (
 
 
 def register(sub) -> None:
-    from ..fidelity import DEFAULT_BUDGET_S, DEFAULT_EPS_GRID, WINDOWS
-    from ..fidelity.criteria import DEFAULT_C_TOLERANCE, DEFAULT_LEADING, DEFAULT_MATCH_FRACTION
-
     f = sub.add_parser(
         "fidelity",
         help="smallest inclination alpha* each engine follows, against dt (docs/fidelity.md)",
     )
+    from ..fidelity import DEFAULT_BUDGET_S, DEFAULT_EPS_GRID, WINDOWS
+    from ..fidelity.criteria import DEFAULT_C_TOLERANCE, DEFAULT_LEADING, DEFAULT_MATCH_FRACTION
+
     f.add_argument("scene", help="a built-in scene or a file, given in (q, p)")
     add_engine(f, many="default: every installed engine but reference and linear")
     add_dt(f, many="default: 1e-3, 1e-4, 1e-5")

@@ -21,27 +21,38 @@ def register(sub) -> None:
         metavar="DIR",
         help="folder for the PNGs (created if missing; files there are replaced only with --force)",
     )
+    f.add_argument(
+        "--only",
+        action="append",
+        metavar="NAME",
+        help="this figure only (repeatable; default: every figure): beta_vs_rho, "
+        "feasibility_border, beta_vs_gamma, boundaries, energy_precession, rod_clin, "
+        "triangle_c_vs_clin",
+    )
     add_force(f)
     add_json(f)
     f.set_defaults(func=run)
 
 
-def check_out(out: Path, force: bool) -> None:
+def check_out(out: Path, force: bool, names=None) -> None:
     """DIR is a folder (or will be one) and every figure in it may be written."""
     from ..figures import figure_paths
     from ..outputs import check_writable, show
 
     if os.path.lexists(out) and not os.path.isdir(out):
         raise BadInput(f"--out {show(out)} is not a directory")
-    for path in figure_paths(out):
+    for path in figure_paths(out, names):
         check_writable(path, force=force)
 
 
 def run(args) -> int:
-    from ..figures import format_figures, make_figures
+    from ..figures import FIGURES, format_figures, make_figures
 
+    unknown = sorted(set(args.only or ()) - set(FIGURES))
+    if unknown:
+        raise BadInput(f"--only {unknown[0]}: no such figure; the figures: {', '.join(FIGURES)}")
     out = Path(args.out)
-    check_out(out, args.force)
-    doc = make_figures(out, progress=log)
+    check_out(out, args.force, args.only)
+    doc = make_figures(out, progress=log, names=args.only)
     emit(doc, args.json, format_figures(doc, out))
     return 0

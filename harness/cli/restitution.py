@@ -27,9 +27,6 @@ PLOT_NAME = "restitution-{engine}.png"
 
 
 def register(sub) -> None:
-    from ..restitution.drops import GEOMETRIES
-    from ..restitution.study import DEFAULT_DTS, DEFAULT_GAMMAS, DEFAULT_PHASES, DEFAULT_SPEEDS
-
     p = sub.add_parser(
         "restitution",
         help="effective restitution e_eff = -u+/u- of single impacts against gamma, per engine",
@@ -38,6 +35,9 @@ def register(sub) -> None:
         "timesteps, with the energy change against the exact loss, penetration and contact "
         "time, and the range where |e_eff/gamma - 1| <= 1 %.",
     )
+    from ..restitution.drops import GEOMETRIES
+    from ..restitution.study import DEFAULT_DTS, DEFAULT_GAMMAS, DEFAULT_PHASES, DEFAULT_SPEEDS
+
     add_engine(p, many="default: reference and every installed fixed-step engine that loads")
     p.add_argument(
         "--gamma",
@@ -102,7 +102,7 @@ def run(args) -> int:
     plots = check_outputs(args, engines)
     total = sum(len(grid.cells(fixed)) for fixed in _fixed(engines))
     with progress_bar(total, "restitution", unit="impact") as bar:
-        doc = run_study(engines, grid, progress=log, tick=bar.update)
+        doc = run_study(engines, grid, progress=log, tick=bar.update, now=bar.set_postfix_str)
     attach(doc, args)
     write_outputs(args, doc, plots)
     emit(doc, args.json, format_restitution(doc))

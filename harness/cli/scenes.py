@@ -16,5 +16,15 @@ def run(args) -> int:
     from ..text import terminal_safe
 
     for name, desc in list_builtin():
-        print(terminal_safe(f"{name:24s} {desc}"))
+        print(terminal_safe(scene_line(name, desc)))
     return 0
+
+
+def scene_line(name: str, desc: str, width: int = 100) -> str:
+    """'name   description', the description wrapped at `width` columns under itself."""
+    import textwrap
+
+    indent = " " * 25
+    return "\n".join(
+        textwrap.wrap(desc, width, initial_indent=f"{name:24s} ", subsequent_indent=indent)
+    )

@@ -15,6 +15,7 @@ from .common import (
     add_scale,
     add_scene,
     add_t_end,
+    add_wide,
     emit,
     load_scene_arg,
     note,
@@ -70,6 +71,7 @@ def register(sub) -> None:
     )
     add_force(s)
     add_json(s)
+    add_wide(s)
     s.set_defaults(func=run)
 
 
@@ -122,7 +124,8 @@ def run(args) -> int:
         note("harness: interrupted; the summary covers the part computed, no file written")
     else:
         write_or_say(args, traj, scene)
-    emit(summary_with_kinds(traj, scene), args.json, format_simulate(traj))
+    text = format_simulate(traj, scale=args.scale, wide=args.wide, label=scene.contacts.label)
+    emit(summary_with_kinds(traj, scene), args.json, text)
     return INTERRUPTED if interrupted else 0
 
 
@@ -156,10 +159,11 @@ def write_or_say(args, traj, scene) -> None:
 
 def write_outputs(args, traj, scene) -> None:
     if args.out:
-        from ..io import write_trajectory_parquet
+        from ..io import trajectory_paths, write_trajectory_parquet
 
+        samples, impacts = trajectory_paths(args.out)
         write_trajectory_parquet(traj, args.out, force=args.force)
-        note(f"wrote {args.out}")
+        note(f"wrote {samples} (samples) and {impacts} (impacts)")
     if args.record:
         from ..recording import record_trajectories
 

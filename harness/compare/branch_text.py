@@ -18,17 +18,29 @@ WIDTH = 100
 LEFT = "left the reference before t_u: no branch"
 
 
-def impacts_text(c) -> str:
-    """'3/8', or '0+89/89' when s chatter-tail bounces were skipped (as `impacts`)."""
-    return f"{c.impacts}{f'+{c.skipped}' if c.skipped else ''}/{c.of}"
+def skipped_text(skipped: int) -> str:
+    """' (s chatter-tail bounces skipped)' when the run passed over any."""
+    return f" ({skipped} chatter-tail bounces skipped)" if skipped else ""
 
 
-def runner_up_text(b: BranchFollow) -> str:
-    """'sequential 1.56', with '≈ ' before it when the choice is not decided."""
-    r = b.runner_up
-    if r is None:
-        return "≈ every branch" if len(b.candidates) > 1 else "-"
-    return f"{'' if b.decided else '≈ '}{r.branch} {r.distance:.3g}"
+def decided_text(b: BranchFollow) -> str:
+    """'yes' when the nearest branch is FOLLOW_FACTOR times nearer than every other,
+    'no: tie' otherwise, '-' when there is no other branch."""
+    if len(b.candidates) < 2:
+        return "-"
+    return "yes" if b.decided and b.runner_up is not None else "no: tie"
+
+
+def branch_row(run: EngineRun) -> list[str]:
+    """One run's row: nearest branch, its distance, the next branch and its distance,
+    whether that is decided, the branch's impacts reproduced, skipped and listed, and the
+    time of the first disagreement."""
+    b = run.branch
+    n, r = b.nearest, b.runner_up
+    return [run.label, n.branch, num(n.distance, ".3g"),
+            "-" if r is None else r.branch, "-" if r is None else num(r.distance, ".3g"),
+            decided_text(b), str(n.impacts), str(n.skipped), str(n.of),
+            num(n.until, ".7g")]  # fmt: skip
 
 
 def branch_sentence(run: EngineRun) -> str | None:
@@ -49,8 +61,8 @@ def branch_sentence(run: EngineRun) -> str | None:
                 f"{n.distance:.3g} and {r.distance:.3g}: undecided")  # fmt: skip
     until = "-" if n.until is None else f"{n.until:.7g} s"
     text = (
-        f"{head}): it reproduces {impacts_text(n)} of {n.branch}'s impacts after t_u, "
-        f"until t = {until}"
+        f"{head}): it reproduces {n.impacts} of {n.branch}'s {n.of} impacts after t_u"
+        f"{skipped_text(n.skipped)}, until t = {until}"
     )
     return text + "."
 
@@ -76,21 +88,18 @@ def branch_lines(result: CompareResult) -> list[str]:
         if not b.followed_reference:
             left.append(f"{run.label}: {LEFT}")
             continue
-        n = b.nearest
-        rows.append([run.label, n.branch, num(n.distance, ".3g"), runner_up_text(b),
-                     impacts_text(n), num(n.until, ".7g"),
-                     "yes" if b.followed_reference else "no"])  # fmt: skip
+        rows.append(branch_row(run))
     if not rows and not left:
         return []
-    header = ["simulator", "branch", "d", "next nearest", "impacts", "until [s]", "on ref"]
+    header = ["simulator", "nearest", "distance", "next", "distance", "decided", "matched",
+              "skipped", "of", "until [s]"]  # fmt: skip
     legend = (
-        "d: distance to the branch (docs/output.md): the first "
-        "impacts after t_u in windows plus the energy difference over E(t_u); ≈: no branch "
+        "distance: to the branch (docs/output.md), from the first impacts after t_u in "
+        "windows plus the energy difference over E(t_u). decided: the nearest branch is "
         f"{FOLLOW_FACTOR:g} times nearer than the next (which law an engine follows: "
-        "harness branches SCENE --engine E --dt ..., docs/laws.md). impacts: k+s/N of "
-        "the branch's impacts after t_u reproduced in order (s chatter tails skipped), "
-        "until the first disagreement. on ref: the run had not diverged from the "
-        "reference before t_u."
+        "harness branches SCENE --engine E --dt ..., docs/laws.md). matched, skipped, of: "
+        "the branch's impacts after t_u reproduced in order, its chatter-tail bounces "
+        "passed over, and how many it lists; until: the first disagreement."
     )
-    shown = [table(rows, header, align="llrlrrl")] if rows else []
+    shown = [table(rows, header, align="llrlrlrrrr")] if rows else []
     return [*textwrap.wrap(head, WIDTH), *shown, *left, *textwrap.wrap(legend, WIDTH)]

@@ -206,7 +206,7 @@ def _header(result: CompareResult) -> list[str]:
     law = f"impact law: {impact_law_text(ref.impact_law or 'paper', ref.simultaneity_window)}"
     text = (
         f"reference: {ref.status.value} at t = {ref.t_final:.7g} s after {len(ref.impacts)} "
-        f"impacts ({seconds(result.reference_wall_time_s)})"
+        f"impacts (wall time {seconds(result.reference_wall_time_s)})"
     )
     if ref.message and ref.status is not Status.T_END:
         text += f": {ref.message}"
@@ -216,10 +216,16 @@ def _header(result: CompareResult) -> list[str]:
     return [head, law, *textwrap.wrap(text, WIDTH, subsequent_indent="  ")]
 
 
+def _reference_counts(result: CompareResult) -> list[int]:
+    return sorted({run.metrics.reference_impacts for run in result.runs})
+
+
 def _verdict_table(result: CompareResult) -> str:
-    """One row per run.  With long engine names beside an exponent the full table is wider
-    than WIDTH: then the `cost` column is left out (`--wide` has it), and if that is not
-    enough the `band` column too (the Horizon lines give the bands)."""
+    """One row per run: how many of the reference's impacts it reproduces, when and why
+    it leaves them, its energy error while it follows and its wall time.  Columns that
+    are empty on every row (no chatter tail skipped, no exponent) are left out; when
+    every run is measured against the same number of reference impacts, the sentence
+    above the table gives it and the `of` column is left out too."""
     rows = []
     for run in result.runs:
         m = run.metrics
@@ -227,30 +233,87 @@ def _verdict_table(result: CompareResult) -> str:
         rows.append(
             [
                 run.label,
-                impacts_cell(m),
-                "-" if t_div is None else f"{t_div:.5g} s",
+                str(m.impacts_matched),
+                str(m.skipped_reference),
+                str(m.reference_impacts),
+                "-" if t_div is None else f"{t_div:.5g}",
                 divergence_short(run, result.scene),
                 _num(m.energy_error_agreeing),
                 _exponent_cell(run.exponent),
-                seconds(run.wall_time_s),
-                horizon_cell(run),
+                f"{run.wall_time_s:.2g}",
             ]
         )
-    header = ["simulator", "impacts", "diverges", "why", "E err", "c", "cost", "band"]
+    header = ["simulator", "matched", "skipped", "of", "diverges at [s]",
+              "first disagreement", "E error", "c", "wall [s]"]  # fmt: skip
+    align = "lrrrrlrrr"
+    drop = {2} if all(r[2] == "0" for r in rows) else set()
+    drop |= {7} if all(r[7] == "-" for r in rows) else set()
+    drop |= {3} if len(_reference_counts(result)) == 1 else set()
+    # when the table is wider than WIDTH (long engine names beside an exponent): the wall
+    # time left out, then the exponent, each with a note (--wide has every column)
     attempts = (
-        (range(8), ""),
-        ((0, 1, 2, 3, 4, 5, 7), "cost left out to stay within 100 characters: --wide has it"),
-        (range(7), "band left out to stay within 100 characters: the Horizon lines give it"),
+        (set(), ""),
+        ({8}, "\n(wall time left out to stay within 100 columns: --wide has it)"),
+        ({8, 7}, "\n(wall time and c left out to stay within 100 columns: --wide has them)"),
     )
-    for keep, note in attempts:
+    for extra, note in attempts:
+        keep = [i for i in range(len(header)) if i not in drop | extra]
         text = table(
             [[r[i] for i in keep] for r in rows],
             [header[i] for i in keep],
-            align="".join("lrrlrrrl"[i] for i in keep),
+            align="".join(align[i] for i in keep),
         )
         if max(len(line) for line in text.splitlines()) <= WIDTH:
-            return text + (f"\n({note})" if note else "")
-    return text + f"\n({note})"
+            return text + note
+    return text + note
+
+
+def _table_intro(result: CompareResult) -> str:
+    counts = _reference_counts(result)
+    of = f"the reference's {counts[0]} impacts" if len(counts) == 1 else "the reference's impacts"
+    return f"Each run against {of} in the time both cover:"
+
+
+def _horizon_table(result: CompareResult) -> list[str]:
+    """The horizon of each run as numbers: impacts the exact model matches (10–90 % of
+    its runs) with its impacts on the run's step grid, whether the run's count reaches
+    that band's 10 % value, the run's own state error and what the exact model
+    perturbed at that error matches."""
+    rows, runs = [], 0
+    for run in result.runs:
+        h = run.horizon
+        if h is None:
+            continue
+        runs = max(runs, h.runs)
+        grid = h.matched_quantiles
+        own = h.own_error_quantiles
+        rows.append(
+            [
+                run.label,
+                str(h.matched),
+                "-" if grid is None else _count_range(grid),
+                "-" if h.within is None else ("yes" if h.within else "no"),
+                _num(h.own_error),
+                "-" if own is None else _count_range(own),
+            ]
+        )
+    if not rows:
+        return []
+    header = ["simulator", "matched", "on step grid", "within", "own error", "at own error"]
+    keep = [i for i in range(len(header)) if i < 2 or any(r[i] != "-" for r in rows)]
+    intro = (
+        "Impacts the exact model itself matches (10–90 % of "
+        f"{runs} runs), with its impacts on the run's step grid and perturbed by the run's "
+        "own state error after its first matched impact:"
+    )
+    return [
+        *textwrap.wrap(intro, WIDTH),
+        table(
+            [[r[i] for i in keep] for r in rows],
+            [header[i] for i in keep],
+            align="".join("lrrlrr"[i] for i in keep),
+        ),
+    ]
 
 
 def _first_to_diverge(result: CompareResult) -> list[str]:
@@ -275,24 +338,50 @@ def _horizon_lines(result: CompareResult) -> list[str]:
         "-" if rate is None else f"{rate:.3g}"
     )
     lines = textwrap.wrap(head + " (perturbed exact model, docs/fidelity.md).", WIDTH)
-    for text in sentences:
-        lines += textwrap.wrap(text, WIDTH, initial_indent="  ", subsequent_indent="    ")
+    lines += _horizon_table(result)
+    for run in result.runs:
+        text = horizon_verdict(run)
+        if text:
+            lines += textwrap.wrap(text, WIDTH, initial_indent="  ", subsequent_indent="    ")
     return lines
 
 
-LEGEND = (
-    "impacts: k/N leading reference impacts the run reproduces (same contact, time within "
-    f"{STEPS_TIME_TOLERANCE:g}·dt + {RELATIVE_TIME_TOLERANCE:g}·t); k+s/N: s slow chatter-tail "
-    "bounces skipped on the way. diverges: first impact "
-    "that disagrees, or attitude off by a tenth of the largest tilt. E err: "
-    "max|E−E_ref|/E_ref(0) while the run follows the reference. c: energy exponent ± its "
-    "standard error, "
-    "only for runs that reach the singularity. cost: wall time. band: impacts the exact model "
-    "matches with its impacts on the run's step grid (10–90 %); in: the run's count is at "
-    "least the 10 % value; b: event-driven runs, the exact model perturbed at the run's own "
-    "error. v2 = vertex 2, b2 = bump 2. "
-    "Every column: --wide; definitions: docs/output.md."
-)
+def horizon_verdict(run: EngineRun) -> str | None:
+    """'mujoco 1e-04 matches 22 impacts, at least the 10 (10 %) the exact model matches
+    on its step grid: ...' (None without the step-grid band)."""
+    h = run.horizon
+    if h is None or h.matched_quantiles is None:
+        return None
+    low = f"{h.matched_quantiles[0]:.0f}"
+    if h.within:
+        return (
+            f"{run.label} matches {h.matched} impacts, at least the {low} that 90 % of the "
+            "exact model's runs on its step grid match: its divergence is the scene's chaos "
+            "at this timestep."
+        )
+    return (
+        f"{run.label} matches {h.matched} impacts, fewer than the {low} that 90 % of the "
+        "exact model's runs on its step grid match: its contact model loses impacts the "
+        "timestep alone would keep."
+    )
+
+
+def legend(result: CompareResult) -> str:
+    """What the verdict table's columns mean, for the columns it shows."""
+    parts = [
+        "simulator: the engine and its timestep dt in s. matched: leading reference impacts "
+        "the run reproduces (same contact, time within "
+        f"{STEPS_TIME_TOLERANCE:g}·dt + {RELATIVE_TIME_TOLERANCE:g}·t)."
+    ]
+    if any(run.metrics.skipped_reference for run in result.runs):
+        parts.append("skipped: slow chatter-tail bounces of the reference passed over on the way.")
+    parts.append("E error: max|E − E_ref|/E_ref(0) while the run follows the reference.")
+    if any(run.exponent is not None and run.exponent.c is not None for run in result.runs):
+        parts.append("c: energy exponent ± its standard error (runs that reach the singularity).")
+    parts.append(
+        "v2 = rim vertex 2, b2 = bump 2. Every column: --wide; definitions: docs/output.md."
+    )
+    return " ".join(parts)
 
 
 def _failures(result: CompareResult) -> list[str]:
@@ -313,13 +402,13 @@ def format_compare(result: CompareResult, wide: bool = False) -> str:
     why, a short legend.  `wide`: every column instead (wider than 100 characters)."""
     if wide:
         return format_compare_wide(result)
-    lines = [*_header(result), "", _verdict_table(result), ""]
+    lines = [*_header(result), "", _table_intro(result), _verdict_table(result), ""]
     lines += _first_to_diverge(result)
     lines += _failures(result)
     branches = branch_lines(result)
     if branches:
         lines += ["", *branches]
-    lines += ["", *textwrap.wrap(LEGEND, WIDTH)]
+    lines += ["", *textwrap.wrap(legend(result), WIDTH)]
     return "\n".join(lines)
 
 

@@ -71,7 +71,7 @@ def header_lines(doc: dict[str, Any]) -> list[str]:
         else "engines run to the reference's end (the whole motion)"
     )
     return [
-        f"fidelity on {doc['scene']}: {doc['scaling']}; {len(refs)} scales, alpha "
+        f"fidelity on {doc['scene']}: {_symbols(doc['scaling'])}; {len(refs)} scales, α "
         f"{refs[0]['alpha']:.3g} .. {refs[-1]['alpha']:.3g}; {window}",
         f"criteria: {doc['criteria']['rule']}",
         exponent_line(doc),
@@ -87,7 +87,7 @@ def exponent_line(doc: dict[str, Any]) -> str:
         ends = sorted({r["status"] for r in refs})
         return (
             f"the reference has no energy exponent c at any scale (it ends {', '.join(ends)}): "
-            "alpha* rests on the impact criterion alone"
+            "α* rests on the impact criterion alone"
         )
     text = (
         f"reference c = {min(with_c):.3f} .. {max(with_c):.3f} at {len(with_c)} of "
@@ -100,7 +100,7 @@ def exponent_line(doc: dict[str, Any]) -> str:
         if doc["window"] == "leading"
         else "no engine run followed the reference to its singularity"
     )
-    return text + f"no engine run has a c ({why}): alpha* rests on the impact criterion alone"
+    return text + f"no engine run has a c ({why}): α* rests on the impact criterion alone"
 
 
 def lowest_pass_text(star: dict[str, Any]) -> str:
@@ -125,22 +125,22 @@ def per_dt_rows(doc: dict[str, Any], cell, fit) -> tuple[list[float | None], lis
 
 def _alpha_star_table(doc: dict[str, Any]) -> str:
     dts, rows = per_dt_rows(doc, alpha_star_text, fit_text)
-    header = ["engine", *[dt_label(d) for d in dts], "k of alpha* ~ dt^k"]
+    header = ["engine", *[dt_label(d) for d in dts], "k of α* ~ dt^k"]
     _, low = per_dt_rows(doc, lowest_pass_text, lambda f: fit_text(f["lowest"]))
     low_header = ["engine", *[dt_label(d) for d in dts], "k"]
     align = "l" + "r" * (len(header) - 1)
     return (
-        "alpha* (smallest inclination passed with every larger one passed; '<=': passes at "
+        "α* (smallest inclination passed with every larger one passed; '<=': passes at "
         "every scale run,\n'>': fails at the largest); k ± its standard error, and the range "
         "the grid's brackets allow for k\n"
         + table(rows, header, align)
-        + "\n\nsmallest inclination passed at all (between it and alpha*, passing depends on "
+        + "\n\nsmallest inclination passed at all (between it and α*, passing depends on "
         "the exact alpha)\n" + table(low, low_header, align) + _horizon_table(doc, dts, align)
     )
 
 
 def _horizon_table(doc: dict[str, Any], dts: list[float | None], align: str) -> str:
-    """alpha* when a run fails only below the horizon band of its scale and dt."""
+    """α* when a run fails only below the horizon band of its scale and dt."""
     if not any("horizon" in s for s in doc["alpha_star"]):
         return ""
     _, rows = per_dt_rows(
@@ -148,7 +148,7 @@ def _horizon_table(doc: dict[str, Any], dts: list[float | None], align: str) -> 
     )
     header = ["engine", *[dt_label(d) for d in dts], ""]
     return (
-        "\n\nalpha* against the horizon (a run fails only when its leading impacts matched "
+        "\n\nα* against the horizon (a run fails only when its leading impacts matched "
         "fall below\nthe 10 % value of the grid model's at that scale and dt; "
         f"{doc.get('horizon_runs')} grid phases)\n" + table(rows, header, align)
     )
@@ -193,9 +193,14 @@ def _ladder(doc: dict[str, Any]) -> str:
         ]
         for (engine, dt), by_eps in groups.items()
     ]
-    header = ["engine", "dt", f"alpha {refs[0]['alpha']:.1e} -> {refs[-1]['alpha']:.1e}"]
+    header = ["engine", "dt", f"α {refs[0]['alpha']:.1e} -> {refs[-1]['alpha']:.1e}"]
     return (
-        "each scale, largest alpha first: + passes, 0-9 fails (tenths of the leading impacts\n"
+        "each scale, largest α first: + passes, 0-9 fails (tenths of the leading impacts\n"
         "matched), h fails but within the horizon band (as good as its dt allows), s skipped\n"
         "(budget), . not assessed\n" + table(rows, header, "lll")
     )
+
+
+def _symbols(text: str) -> str:
+    """'q -> eps^2 q' as 'q → ε² q' (the JSON keeps the ASCII spelling)."""
+    return text.replace("->", "→").replace("eps^2", "ε²").replace("eps", "ε")

@@ -44,19 +44,22 @@ def format_figures(doc: dict, out_dir: Path) -> str:
     return "\n".join(lines)
 
 
-def figure_paths(out_dir: Path) -> list[Path]:
-    """The files `make_figures` writes into out_dir (each figure is saved as <name>.png)."""
-    return [Path(out_dir) / f"{name}.png" for name in FIGURES]
+def figure_paths(out_dir: Path, names=None) -> list[Path]:
+    """The files `make_figures` writes into out_dir (each figure is saved as <name>.png);
+    `names`: those figures only (None: all)."""
+    return [Path(out_dir) / f"{name}.png" for name in names or FIGURES]
 
 
-def make_figures(out_dir: Path, progress=print) -> dict:
-    """Compute and save every figure; returns name → {path, paper, ours, agree}."""
+def make_figures(out_dir: Path, progress=print, names=None) -> dict:
+    """Compute and save every figure (`names`: those only, in FIGURES's order); returns
+    name → {path, paper, ours, agree}."""
     from ..progress import progress_bar
 
     out_dir = Path(out_dir)  # created with the first figure (harness.outputs)
+    chosen = {name: fn for name, fn in FIGURES.items() if names is None or name in names}
     doc = {}
-    with progress_bar(len(FIGURES), "figures", unit="figure") as bar:
-        for name, fn in FIGURES.items():
+    with progress_bar(len(chosen), "figures", unit="figure") as bar:
+        for name, fn in chosen.items():
             progress(f"figure {name}")
             bar.set_postfix_str(name, refresh=False)
             doc[name] = fn(out_dir, progress)

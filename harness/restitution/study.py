@@ -162,11 +162,15 @@ def run_study(
     grid: Grid,
     progress: Callable[[str], None] | None = None,
     tick: Callable[[int], None] | None = None,
+    now: Callable[[str], None] | None = None,
 ) -> dict:
     """Every engine on every cell: {"engines": [{engine, fixed_step, rows, contract,
-    mapping, wall_time_s}]}.  `tick(1)` after each cell."""
+    mapping, wall_time_s}]}.  `tick(1)` after each cell; `now(engine)` when an engine
+    starts (the progress line's "now")."""
     out = []
     for engine in engines:
+        if now is not None:
+            now(engine)
         fixed = is_fixed_step(engine)
         t0 = time.perf_counter()
         rows = []

@@ -21,11 +21,11 @@ OUTCOME_CODES = {"ok": None, "no contact": "none", "no separation": "stuck"}
 def format_restitution(doc: dict) -> str:
     g = doc["grid"]
     head = (
-        f"single impacts, e_eff = -u+/u- against gamma; faithful: "
-        f"|e_eff/gamma - 1| <= {100 * doc['faithful']:g} %"
+        f"single impacts, e_eff = −u⁺/u⁻ against γ; faithful: "
+        f"|e_eff/γ − 1| ≤ {100 * doc['faithful']:g} %"
     )
     grid = (
-        f"grid: gamma {_values(g['gamma'])}; impact speed {_values(g['speed'])} sqrt(g a); "
+        f"grid: γ {_values(g['gamma'])}; impact speed {_values(g['speed'])} √(g a); "
         f"dt {_values(g['dt'])}; onset phase {_values(g.get('phase', []))} of a step; "
         f"geometry {', '.join(g['geometry'])}"
     )
@@ -49,8 +49,9 @@ def engine_text(e: dict, grid: dict) -> list[str]:
 
 
 def _table(e: dict, grid: dict, speeds: list[float], extras: bool) -> list[str]:
-    head = KEY.format("geom", "dt", "gamma") + "".join(f"{_speed(v):>{CELL}}" for v in speeds)
-    lines = [head + (EXTRAS_HEAD if extras else "")]
+    head = KEY.format("geom", "dt [s]", "γ") + "".join(f"{_speed(v):>{CELL}}" for v in speeds)
+    over = " " * (len(KEY.format("", "", "")) + 1) + "e_eff/γ − 1 [%] at impact speed u⁻ [√(g a)]:"
+    lines = [over, head + (EXTRAS_HEAD if extras else "")]
     for key, rows in _groups(e["rows"], grid):
         cells = "".join(
             f"{_cell(worst_row([r for r in rows if r['speed'] == v])):>{CELL}}" for v in speeds

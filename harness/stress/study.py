@@ -174,7 +174,7 @@ def _engine_row(
 
     cap = HARD_CAP_FACTOR * budget_s
     guess = "not predicted" if predicted is None else f"predicted {predicted:.3g} s"
-    bar.set_postfix_str(f"{case.name}: {engine}, {guess}, stopped at {cap:g} s", refresh=True)
+    bar.set_postfix_str(f"{case.name}: {engine}, {guess}, hard cap {cap:g} s", refresh=True)
     row, crashed = run_capped(judged_run, cap, tick=bar.refresh)
     if row is None and crashed is None:
         why = f"stopped at the hard cap of {cap:g} s ({guess}, budget {budget_s:g} s)"

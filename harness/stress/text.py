@@ -8,27 +8,29 @@ many runs are degraded.
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
 from ..text import num as cell_text
 from ..text import table
+from .budget import HARD_CAP_FACTOR
 from .judge import FAILED_ENERGY_GAIN, FAILED_PENETRATION
 
 WIDTH = 100
 SHORT_VERDICT = {
     "ok": "ok",
-    "degraded": "degr",
-    "failed": "FAIL",
-    "skipped (budget)": "skip",
+    "degraded": "degraded",
+    "failed": "FAILED",
+    "skipped (budget)": "skipped",
     "skipped (not runnable)": "n/a",
 }
 LEGEND = (
-    "ok: as the reference within the simulator's tolerances; degr (degraded): energy gain\n"
-    "or penetration above its tolerance, or a missed or spurious impact; FAIL (failed): NaN,\n"
-    f"not finished, energy gain > {FAILED_ENERGY_GAIN:.0%}, penetration > {FAILED_PENETRATION:g} L "
-    "(L: the case's length scale),\n"
-    "or none of the reference's impacts matched; skip: predicted over the budget; n/a:\n"
-    "cannot run at this dt.  --wide: every measurement and every reason; --json: every number"
+    "ok: as the reference within the simulator's tolerances; degraded: energy gain or\n"
+    "penetration above its tolerance, or a missed or spurious impact; FAILED: NaN, not\n"
+    f"finished, energy gain > {FAILED_ENERGY_GAIN:.0%}, penetration > {FAILED_PENETRATION:g} L "
+    "(L: the case's length scale), or none of the\n"
+    "reference's impacts matched; skipped: predicted over the budget; n/a: cannot run at\n"
+    "this dt.  --wide: every measurement and every reason; --json: every number"
 )
 # Verdicts whose reasons the default report lists (degraded ones: --wide).
 LISTED = ("failed", "skipped (budget)", "skipped (not runnable)")
@@ -41,9 +43,12 @@ def num(x: Any, spec: str = ".2e") -> str:
 
 def format_stress(doc: dict[str, Any], wide: bool = False) -> str:
     """The report (module docstring)."""
-    lines = [
-        f"stress: fixed-step engines at dt = {doc['dt']:g} s, budget {doc['budget_s']:g} s per run"
-    ]
+    budget = doc["budget_s"]
+    lines = textwrap.wrap(
+        f"stress: fixed-step engines at dt = {doc['dt']:g} s; a run predicted over {budget:g} s "
+        f"is skipped, stopped at {HARD_CAP_FACTOR * budget:g} s",
+        WIDTH,
+    )
     if wide:
         lines += [wide_table(doc), "", *reason_lines(doc, wide=True)]
     else:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 import time
 from collections import deque
@@ -113,6 +114,18 @@ def _after_failure(work: _Work, exc: BaseException, queue: deque):
     return failed_rows(ch, f"worker failed: {type(exc).__name__}: {exc}")
 
 
+# runtimes that start thread pools at import: a process forked after one of them is
+# loaded may deadlock on a lock a thread of the parent held (JAX warns so at the fork)
+THREADED_RUNTIMES = ("jax",)
+
+
+def start_method(methods: list[str]) -> str:
+    """'fork' (workers share the compiled simulator) unless the platform lacks it or a
+    threaded runtime is loaded in this process (then 'spawn')."""
+    threaded = any(name in sys.modules for name in THREADED_RUNTIMES)
+    return "fork" if "fork" in methods and not threaded else "spawn"
+
+
 def run_local(
     chunks: list[Chunk], workers: int | None = None, fn=run_chunk
 ) -> Iterator[tuple[Chunk, list[dict]]]:
@@ -122,8 +135,7 @@ def run_local(
     from concurrent.futures.process import BrokenProcessPool
 
     workers = workers or os.cpu_count() or 1
-    methods = mp.get_all_start_methods()
-    ctx = mp.get_context("fork" if "fork" in methods else "spawn")
+    ctx = mp.get_context(start_method(mp.get_all_start_methods()))
 
     def new_pool():
         return ProcessPoolExecutor(

@@ -91,19 +91,20 @@ def format_summary(doc: dict) -> str:
     if doc["engine"] in ("reference", "linear"):
         law = f", impact law {impact_law_text(doc['impact_law'], doc['simultaneity_window'])}"
     lines = [
-        f"exponent sweep: engine {doc['engine']}{law}, n = {doc['n']}, "
-        f"{len(g['restitution'])} γ x {len(g['gyration'])} ρ x {g['samples']} runs, "
-        f"seed {g['seed']}",
+        f"exponent sweep: engine {doc['engine']}{law}",
+        f"grid: n = {doc['n']}, {len(g['restitution'])} values of γ × {len(g['gyration'])} of "
+        f"ρ, {g['samples']} runs each from random initial states (seed {g['seed']})",
         f"runs: {t['rows']} of {t['total']} stored ({t['stored_before']} before, "
         f"{t['computed']} computed now" + (f", {t['missing']} missing)" if t["missing"] else ")"),
-        "status: " + ", ".join(f"{k} {v}" for k, v in doc["counts"].items() if v),
+        "runs ending in: " + ", ".join(f"{k} {v}" for k, v in doc["counts"].items() if v),
         f"wall time {doc['wall_time_s']:.1f} s (runs {doc['compute_time_s']:.1f} s, "
         f"figures {doc['figures_time_s']:.1f} s), executor {doc['executor']}, "
         f"load average {doc['load_average_start'][0]:.2f} -> {doc['load_average_end'][0]:.2f}",
         f"runs' own time, summed over all stored runs: {doc['run_time_sum_s']['wall']:.1f} s "
         f"wall, {doc['run_time_sum_s']['cpu'] or 0.0:.1f} s CPU",
         "",
-        "mean c (rows ρ, columns γ; '-' no run with a c)",
+        "mean energy exponent c of E ~ (t_f − t)^c over the runs with a fitted c",
+        "(rows ρ, columns γ; '-': no run of that cell has one)",
     ]
     gam, rho = g["restitution"], g["gyration"]
     if len(gam) <= 25:
@@ -120,4 +121,10 @@ def format_summary(doc: dict) -> str:
     lines.append(f"parts: {doc['parts']['dir']} ({doc['parts']['count']} files)")
     for name, path in doc["figures"].items():
         lines.append(f"{name}: {path}")
-    return "\n".join(lines)
+    return "\n".join(wrapped for line in lines for wrapped in _wrap(line))
+
+
+def _wrap(line: str, width: int = 100) -> list[str]:
+    import textwrap
+
+    return textwrap.wrap(line, width, subsequent_indent="  ") if len(line) > width else [line]

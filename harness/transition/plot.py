@@ -10,6 +10,12 @@ import numpy as np
 
 COLOURS = {"rim": "C0", "bump": "C3"}
 SHADES = {"rim_only": "C0", "mixed": "C4", "bumps_only": "C3"}
+# t_f is the singularity when the run reached it, else its last impact (regimes.end_time)
+XLABELS = {
+    "t_singularity": "time to the singularity t_f - t [s]",
+    "last_impact": "time to the last impact t_f - t [s] (the run ends there, short of a singularity)",
+    "last_time": "time to the run's end t_f - t [s]",
+}
 LABELS = {"rim_only": "rim only", "mixed": "mixed", "bumps_only": "bumps only"}
 
 
@@ -39,7 +45,7 @@ def transition_figure(doc: dict[str, Any]):
         ax.axvspan(lo, hi, color=SHADES[r["regime"]], alpha=0.12)
         ax.plot([], [], color=SHADES[r["regime"]], alpha=0.3, lw=8, label=LABELS[r["regime"]] + c)
     ax.set_xlim(left=floor)
-    ax.set_xlabel("time to the singularity t_f - t [s]")
+    ax.set_xlabel(XLABELS.get(doc.get("t_f_source"), XLABELS["t_singularity"]))
     ax.set_ylabel("energy above the rest on the bumps [J]")
     tk = doc["takeover"]
     ax.set_title(

@@ -15,7 +15,12 @@ is the singularity when the run reached it, else its last time.
 Per regime: duration, time to the singularity at its start, impacts of each kind, tilt
 and energy at its ends, and the local exponent c of E ≈ a (t_f − t)^c over its impacts
 (the regression of reference.exponent, `fit_energy_exponent`, with E_i the energy
-above the three-point rest just before impact i: reference.bumpy.bumpy_excess_energy).
+above the three-point rest just before impact i: reference.bumpy.bumpy_excess_energy),
+given only where its impacts' energies span REGIME_MIN_DECADES decades or more (a
+regression over an energy that barely changes measures no power law; `c_reason` says
+why c is None).  A run that ends short of its singularity keeps an energy E_end at t_f
+(its last impact): the law then describes E − E_end, so only impacts with E above
+PLATEAU_FACTOR · E_end enter the fit (the plateau at E_end is not a power of t_f − t).
 """
 
 from __future__ import annotations
@@ -27,7 +32,13 @@ from typing import Any
 import numpy as np
 
 from reference.bumpy import BUMP, RIM, bumpy_excess_energy, contact_kind_names
-from reference.exponent import fit_energy_exponent, pre_impact_samples, states_of, time_to_go
+from reference.exponent import (
+    MIN_POINTS,
+    fit_energy_exponent,
+    pre_impact_samples,
+    states_of,
+    time_to_go,
+)
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
@@ -119,6 +130,13 @@ class RunSeries:
     t_f: float
     t_f_source: str
 
+    @property
+    def e_end(self) -> float:
+        """The energy the run keeps at t_f: 0 at its singularity, else its last sample's."""
+        if self.t_f_source == "t_singularity" or not len(self.energy):
+            return 0.0
+        return max(float(self.energy[-1]), 0.0)
+
     def at(self, values: np.ndarray, t: float) -> float | None:
         """A sample series interpolated at time t (None without samples)."""
         if not len(self.t):
@@ -153,6 +171,29 @@ def run_series(traj: Trajectory, scene: Scene) -> RunSeries:
     )
 
 
+# a regime's c needs its impacts' energies to span this many decades (and MIN_POINTS
+# impacts, the estimator's own minimum)
+REGIME_MIN_DECADES = 1.0
+# impacts within this factor of the energy a run keeps at its end are on its plateau
+PLATEAU_FACTOR = 10.0
+
+
+def regime_exponent(ttg: np.ndarray, energy: np.ndarray, e_end: float) -> dict[str, Any]:
+    """`fit_energy_exponent` over a regime's impacts above PLATEAU_FACTOR · e_end (the
+    energy the run keeps at t_f; 0 at a singularity), with c None (and `reason`) unless
+    they span REGIME_MIN_DECADES with MIN_POINTS points."""
+    above = energy > PLATEAU_FACTOR * e_end
+    fit = fit_energy_exponent(ttg[above], energy[above])
+    if fit["n_points"] < MIN_POINTS:
+        reason = f"{fit['n_points']} impacts (needs {MIN_POINTS})"
+    elif not fit["log10_energy_span"] >= REGIME_MIN_DECADES:
+        reason = (f"energy spans {fit['log10_energy_span']:.2g} decades "
+                  f"(needs {REGIME_MIN_DECADES:g})")  # fmt: skip
+    else:
+        return {**fit, "reason": ""}
+    return {**fit, "c": None, "c_stderr": None, "reason": reason}
+
+
 # Which ends of its span a regime's impacts may lie on: the first bump impact opens the
 # mixed regime, the last rim impact closes it.
 CLOSED_ENDS = {RIM_ONLY: (True, False), MIXED: (True, True), BUMPS_ONLY: (False, True)}
@@ -163,7 +204,7 @@ def regime_summary(series: RunSeries, name: str, t0: float, t1: float) -> dict[s
     t = series.impact_t
     with_start, with_end = CLOSED_ENDS[name]
     sel = ((t >= t0) if with_start else (t > t0)) & ((t <= t1) if with_end else (t < t1))
-    fit = fit_energy_exponent(series.impact_ttg[sel], series.impact_energy[sel])
+    fit = regime_exponent(series.impact_ttg[sel], series.impact_energy[sel], series.e_end)
     kinds = series.impact_kind[sel]
     return {
         "regime": name,
@@ -180,6 +221,7 @@ def regime_summary(series: RunSeries, name: str, t0: float, t1: float) -> dict[s
         "c_stderr": fit["c_stderr"],
         "c_points": fit["n_points"],
         "c_log10_energy_span": fit["log10_energy_span"],
+        "c_reason": fit["reason"],
     }
 
 

@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
+
+from ..text import table
+
+WIDTH = 100
 
 NAMES = {"rim_only": "rim only", "mixed": "mixed", "bumps_only": "bumps only"}
 
@@ -12,34 +17,72 @@ def _g(x, fmt: str = ".3g") -> str:
 
 
 def format_transition(doc: dict[str, Any]) -> str:
+    """The scene, one row per regime (when, how long, how many impacts of each kind), the
+    tilt and energy exponent of each regime, and when the bumps take over; within 100
+    columns (statuses wrapped)."""
     tk = doc["takeover"]
+    head = f"transition: {doc['scene']} on {doc['engine']}: {doc['status']} ({doc['message']})"
     lines = [
-        f"transition: {doc['scene']} on {doc['engine']}: {doc['status']} ({doc['message']})",
-        f"  n = {doc['n']}, rho = {doc['gyration']:g}, gamma = {doc['restitution']:g}, "
-        f"a = {doc['radius']:g}, g = {doc['gravity']:g}; bumps Delta = {_g(tk['delta'])} "
-        f"(Delta/a = {_g(tk['delta_over_a'])}, Delta/d = {_g(tk['delta_over_d'])})",
-        f"  start tilt {_g(doc['initial_tilt'])} rad; end t_f = {_g(doc['t_f'], '.10g')} "
+        *textwrap.wrap(head, WIDTH, subsequent_indent="  "),
+        f"  n = {doc['n']}, ρ = {doc['gyration']:g}, γ = {doc['restitution']:g}, "
+        f"a = {doc['radius']:g} m, g = {doc['gravity']:g} m/s²; bumps of height "
+        f"Δ = {_g(tk['delta'])} m",
+        f"  (Δ/a = {_g(tk['delta_over_a'])}, Δ/d = {_g(tk['delta_over_d'])}); start tilt "
+        f"{_g(doc['initial_tilt'])} rad; end t_f = {_g(doc['t_f'], '.10g')} s "
         f"({doc['t_f_source']})",
         "",
-        f"  {'regime':<11} {'from [s]':>11} {'duration':>10} {'t_f - t':>10} {'rim':>7} "
-        f"{'bump':>7} {'tilt start':>10} {'tilt end':>10} {'c':>14}",
     ]
-    for r in doc["regimes"]:
-        c = "-" if r["c"] is None else f"{r['c']:.3f}±{_g(r['c_stderr'], '.2g')}"
-        lines.append(
-            f"  {NAMES[r['regime']]:<11} {r['t_start']:>11.6g} {r['duration']:>10.3g} "
-            f"{r['time_to_singularity_at_start']:>10.3g} {r['impacts']['rim']:>7} "
-            f"{r['impacts']['bump']:>7} {_g(r['tilt_start']):>10} {_g(r['tilt_end']):>10} {c:>14}"
-        )
+    regimes = doc["regimes"]
+    lines.append(
+        table(
+            [
+                [
+                    NAMES[r["regime"]],
+                    f"{r['t_start']:.6g}",
+                    f"{r['duration']:.3g}",
+                    f"{r['time_to_singularity_at_start']:.3g}",
+                    str(r["impacts"]["rim"]),
+                    str(r["impacts"]["bump"]),
+                ]
+                for r in regimes
+            ],
+            ["regime", "from t [s]", "lasting [s]", "t_f − t [s]", "rim impacts", "bump impacts"],
+            align="lrrrrr",
+        )  # fmt: skip
+    )
+    lines += ["", _tilt_table(regimes), ""]
     lines += [
-        "",
-        f"  bumps first act at t = {_g(tk['first_bump_t'], '.6g')}, "
-        f"tilt {_g(tk['first_bump_tilt'])}"
-        f" = {_g(tk['first_bump_tilt_over_delta_a'])} Delta/a "
-        f"(face reaches a bump at Delta/(a - b) = {_g(tk['face_reach_tilt'])})",
-        f"  rim last acts at t = {_g(tk['last_rim_t'], '.6g')}, tilt {_g(tk['last_rim_tilt'])}"
-        f" = {_g(tk['last_rim_tilt_over_delta_a'])} Delta/a",
+        f"  bumps first act at t = {_g(tk['first_bump_t'], '.6g')} s, "
+        f"tilt {_g(tk['first_bump_tilt'])} rad"
+        f" = {_g(tk['first_bump_tilt_over_delta_a'])} Δ/a "
+        f"(the face reaches a bump at Δ/(a − b) = {_g(tk['face_reach_tilt'])} rad)",
+        f"  rim last acts at t = {_g(tk['last_rim_t'], '.6g')} s, tilt "
+        f"{_g(tk['last_rim_tilt'])} rad = {_g(tk['last_rim_tilt_over_delta_a'])} Δ/a",
         f"  from the first bump to the end: {_g(tk['time_from_first_bump_to_end'])} s "
-        "(paper: tilt ~ Delta/d, during the last 0.1 ... 1 s)",
+        "(paper: tilt ~ Δ/d, during the last 0.1 ... 1 s)",
     ]
-    return "\n".join(lines)
+    return "\n".join(line for chunk in lines for line in _wrapped(chunk))
+
+
+def _tilt_table(regimes: list[dict[str, Any]]) -> str:
+    """Each regime's tilt at its start and end and the energy exponent c of E ~ (t_f − t)^c
+    fitted over it, with its standard error."""
+    rows = [
+        [
+            NAMES[r["regime"]],
+            _g(r["tilt_start"]),
+            _g(r["tilt_end"]),
+            "-" if r["c"] is None else f"{r['c']:.3f}",
+            _g(r["c_stderr"], ".2g"),
+        ]
+        for r in regimes
+    ]
+    header = ["regime", "tilt at start [rad]", "tilt at end [rad]", "energy exponent c", "± c"]
+    return table(rows, header, align="lrrrr")
+
+
+def _wrapped(text: str) -> list[str]:
+    """A line of the report within WIDTH columns (tables and blank lines as they are)."""
+    if "\n" in text or len(text) <= WIDTH:
+        return text.splitlines() or [text]
+    return textwrap.wrap(text, WIDTH, subsequent_indent="    ")

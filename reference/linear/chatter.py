@@ -226,20 +226,19 @@ def format_chatter(doc: dict) -> str:
     """The eigenvalues, CC/PCC, the rod's thresholds and the self-similar pairs, then
     its legend (CHATTER_LEGEND, without the parts describing what is not printed)."""
     lines = [
-        f"chatter (no gravity): n = {doc['n']}, rho = {doc['gyration']}, "
-        f"gamma = {doc['restitution']}",
+        f"chatter (no gravity): n = {doc['n']}, ρ = {doc['gyration']}, γ = {doc['restitution']}",
         "eigenvalues of R^-1 U0: "
         + ", ".join(f"{re:.6g}{im:+.6g}i" if im else f"{re:.9g}" for re, im in doc["eigenvalues"]),
         f"CC  {'yes' if doc['cc'] else 'no'}    PCC  {'yes' if doc['pcc'] else 'no'}",
     ]
     if doc.get("psi") is not None:
-        lines.append(
-            f"rod: psi = {doc['psi']:.6g}; complete chatter without gravity "
-            f"{'yes' if doc['cc_without_gravity'] else 'no'} "
-            f"(psi > {doc['psi_threshold_without_gravity']:.6g}),"
-            f" with gravity {'yes' if doc['cc_with_gravity'] else 'no'} "
-            f"(psi > {doc['psi_threshold_with_gravity']:.6g})"
-        )
+        lines += [
+            f"rod: psi = {doc['psi']:.6g}; complete chatter",
+            f"  without gravity: {'yes' if doc['cc_without_gravity'] else 'no'} "
+            f"(psi > {doc['psi_threshold_without_gravity']:.6g})",
+            f"  with gravity:    {'yes' if doc['cc_with_gravity'] else 'no'} "
+            f"(psi > {doc['psi_threshold_with_gravity']:.6g})",
+        ]
     if doc.get("pairs"):
         rows = [
             [

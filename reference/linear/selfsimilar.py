@@ -417,8 +417,8 @@ def format_selfsimilar(doc: dict) -> str:
             ]
         )
     head = (
-        f"self-similar motion: n = {doc['n']}, rho = {doc['gyration']}, "
-        f"gamma = {doc['restitution']} ({doc['smooth_phase']})"
+        f"self-similar motion: n = {doc['n']}, ρ = {doc['gyration']}, "
+        f"γ = {doc['restitution']} ({doc['smooth_phase']})"
     )
     return (
         head
