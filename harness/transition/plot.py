@@ -13,7 +13,7 @@ SHADES = {"rim_only": "C0", "mixed": "C4", "bumps_only": "C3"}
 # t_f is the singularity when the run reached it, else its last impact (regimes.end_time)
 XLABELS = {
     "t_singularity": "time to the singularity t_f - t [s]",
-    "last_impact": "time to the last impact t_f - t [s] (the run ends there, short of a singularity)",
+    "last_impact": "time to the last impact t_f - t [s] (the run ends there, short of t_f)",
     "last_time": "time to the run's end t_f - t [s]",
 }
 LABELS = {"rim_only": "rim only", "mixed": "mixed", "bumps_only": "bumps only"}
