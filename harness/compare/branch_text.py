@@ -102,4 +102,5 @@ def branch_lines(result: CompareResult) -> list[str]:
         "passed over, and how many it lists; until: the first disagreement."
     )
     shown = [table(rows, header, align="llrlrlrrrr")] if rows else []
-    return [*textwrap.wrap(head, WIDTH), *shown, *left, *textwrap.wrap(legend, WIDTH)]
+    explained = textwrap.wrap(legend, WIDTH) if rows else []  # the columns, when shown
+    return [*textwrap.wrap(head, WIDTH), *shown, *left, *explained]
