@@ -1,4 +1,4 @@
-"""Oracle: event location that never misses a root (docs/architecture.md, "Events").
+"""Oracle: event location that never misses a root (docs/events.md).
 
 Each contact's gap g(s) is smooth.  From its value, first and second derivative at the
 current time and bounds on its second and third derivatives over the search horizon, two
