@@ -120,6 +120,4 @@ def run_engines(args) -> int:
 
 def _scene(args):
     """SCENE: a file, a built-in scene or one of the suite's landings."""
-    from ..branches.suite import LANDINGS, landing
-
-    return landing(args.scene) if args.scene in LANDINGS else load_scene_arg(args)
+    return load_scene_arg(args)

@@ -378,11 +378,18 @@ class StepProgress:
 
 
 def load_scene_arg(args):
-    """The SCENE argument (a file or a built-in name), with --scale applied (the scaled
-    scene passes the same checks as a scene file, below-ground included)."""
+    """The SCENE argument (a file, a built-in name, or one of `branches --suite`'s
+    landings, which start on several contacts), with --scale applied (the scaled scene
+    passes the same checks as a scene file, below-ground included)."""
+    from pathlib import Path
+
+    from ..branches.suite import LANDINGS, landing
     from ..scenes import resolve_scene
 
-    scene = resolve_scene(args.scene)
+    if args.scene in LANDINGS and not Path(args.scene).exists():
+        scene = landing(args.scene)
+    else:
+        scene = resolve_scene(args.scene)
     if getattr(args, "scale", None) is not None:
         scene = scene.scaled(args.scale)
     return with_impact_law_args(scene, args)
