@@ -23,11 +23,11 @@ ROOT = Path(__file__).resolve().parent.parent
 TOY = ROOT / "examples" / "toy-engine"
 
 # A run the reference's compiled loop works on for far longer than the test waits: the
-# transition study's 100-gon at gamma = 0, whose contact phase creeps at t = 0.2969 once
-# the disk lies nearly flat on one bump (docs/transition.md); the loop returns to Python
-# every work_budget steps (about 0.5 s there).
-LONG_REFERENCE_RUN = (ROOT / "reference" / "scenes" / "bumpy-transition.toml").read_text()
-LONG_REFERENCE_RUN = LONG_REFERENCE_RUN.replace("restitution = 0.5", "restitution = 0.0")
+# elastic hexagon bouncing for 1e6 time units (about 8.5 impacts per unit, a few hundred
+# thousand impacts a second); the loop returns to Python every work_budget steps.
+LONG_REFERENCE_RUN = (ROOT / "reference" / "scenes" / "elastic-hexagon.toml").read_text()
+LONG_REFERENCE_RUN = LONG_REFERENCE_RUN.replace("t_end = 20.0", "t_end = 1e6")
+LONG_REFERENCE_RUN = LONG_REFERENCE_RUN.replace("max_impacts = 100000", "max_impacts = 10000000")
 
 
 def _start(argv: list[str], cwd: Path) -> subprocess.Popen:

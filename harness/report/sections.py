@@ -188,7 +188,7 @@ def recording_link(path: str | None, out_dir: Path) -> str:
 
 def bench_section(doc: dict[str, Any]) -> str:
     from ..bench import work_precision_figure
-    from ..bench.table import matched_text
+    from ..bench.table import match_columns
 
     tr = doc["truth"]
     parts = [
@@ -205,7 +205,7 @@ def bench_section(doc: dict[str, Any]) -> str:
             r["setting"],
             r["status"],
             num(r["wall_time_s"], ".3g"),
-            matched_text(r),
+            *match_columns(r),
             num(r["impact_time_error"], ".2e"),
             num(r["energy_error"], ".2e"),
             num(r["energy_error_agreeing"], ".2e"),
@@ -218,12 +218,15 @@ def bench_section(doc: dict[str, Any]) -> str:
         "status",
         "median [s]",
         "matched",
+        "of",
+        "follows",
         "t err [s]",
         "E err",
         "E err<div",
     ]
-    caption = "work-precision rows (matched k/N*: the run does not follow the reference, fewer "
-    caption += "than 9 of its first 10 impacts matched, and is left out of the summary)"
+    caption = "work-precision rows (matched: the first reference impacts the run reproduces, of "
+    caption += "the reference's impacts in the common window; follows no: fewer than 9 of its "
+    caption += "first 10 impacts matched, left out of the summary)"
     parts.append(table(header, rows, caption, left=2))
     for s in doc.get("skipped", []):
         parts.append(paragraph(f"skipped: {s['engine']} {s['setting']}: {s['reason']}", "muted"))
