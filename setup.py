@@ -18,6 +18,27 @@ ROOT = Path(__file__).resolve().parent
 CORE_MODULE = "reference.core._aot"  # reference.compiled.AOT_MODULE
 
 
+def reuse_fresh_core(target: Path) -> Path | None:
+    """The module already beside the sources, copied to `target` with its stamp, when
+    that stamp matches the sources (a second `pip install -e`, as `make test` after the
+    core install, then skips compiling the same module again); None otherwise."""
+    from reference.compiled import STAMP_FILE, source_stamp
+
+    in_place = STAMP_FILE.parent / target.name
+    try:
+        fresh = in_place.is_file() and STAMP_FILE.read_text().strip() == source_stamp()
+    except OSError:
+        return None
+    if not fresh:
+        return None
+    target.parent.mkdir(parents=True, exist_ok=True)
+    if in_place.resolve() != target.resolve():
+        shutil.copyfile(in_place, target)
+        shutil.copyfile(STAMP_FILE, target.with_name(STAMP_FILE.name))
+    print(f"the reference's compiled core beside the sources is up to date: {in_place.name}")
+    return target
+
+
 class BuildCompiledCore(build_ext):
     """build_ext for the one module numba.pycc compiles (it runs the C compiler itself)."""
 
@@ -26,7 +47,8 @@ class BuildCompiledCore(build_ext):
             sys.path.insert(0, str(ROOT))  # the sources being built, not an installed copy
         from reference.core import aot
 
-        self.built_core = aot.build_or_explain(Path(self.get_ext_fullpath(ext.name)).parent)
+        target = Path(self.get_ext_fullpath(ext.name))
+        self.built_core = reuse_fresh_core(target) or aot.build_or_explain(target.parent)
 
     def copy_extensions_to_source(self) -> None:
         """An editable install (`pip install -e .`) uses the sources in place: setuptools
