@@ -51,6 +51,16 @@ def make_scene(
     )
 
 
+def tilted_spinning_state() -> np.ndarray:
+    """A body tilted about all three axes, falling, moving sideways and spinning: the
+    generic pre-impact state the single- and multi-contact impact tests start from."""
+    y = np.zeros(13)
+    y[3:7] = qt.from_rotation_vector([0.05, -0.08, 0.3])
+    y[7:10] = [0.1, -0.2, -0.9]
+    y[10:13] = [0.4, 0.3, 1.2]
+    return y
+
+
 @pytest.fixture
 def scene_factory():
     return make_scene
@@ -139,7 +149,7 @@ def pytest_runtest_logreport(report) -> None:
 
 
 def pytest_sessionfinish(session, exitstatus) -> None:
-    """In CI every engine's tests run: a skip for a missing extra fails the session."""
+    """In CI every engine's tests run: a skip for a missing extra fails the run."""
     if _ci() and _missing_extra_skips and session.exitstatus == 0:
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
 

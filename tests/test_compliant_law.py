@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 from reference import ReferenceOptions, simulate
-from reference import quaternion as qt
 from reference.core.compliant import (
     SETTLED,
     compliant_impulses,
@@ -20,7 +19,7 @@ from reference.core.compliant import (
     restitution_of_damping,
     work_size,
 )
-from tests.conftest import make_scene
+from tests.conftest import make_scene, tilted_spinning_state
 from tests.oracle import compliant as oracle
 from tests.oracle.body import BodyModel
 from tests.oracle.impact import impact_impulse
@@ -65,10 +64,7 @@ def test_the_limits_are_undamped_and_infinitely_damped():
 def test_one_contact_is_eq_F(gamma, mass):
     scene = make_scene(n=5, gamma=gamma)
     model = BodyModel.from_scene(scene)
-    y = np.zeros(13)
-    y[3:7] = qt.from_rotation_vector([0.05, -0.08, 0.3])
-    y[7:10] = [0.1, -0.2, -0.9]
-    y[10:13] = [0.4, 0.3, 1.2]
+    y = tilted_spinning_state()
     _, _, W, u = delassus(model, y, [2])
     lam, u_post = _compliant(W, u, gamma, mass)
     assert u_post[0] == pytest.approx(-gamma * u[0], rel=1e-12, abs=1e-12 * abs(u[0]))

@@ -19,7 +19,7 @@ from reference.core.impact_laws import (
     moreau_impulses,
     sequential_impulses,
 )
-from tests.conftest import make_scene
+from tests.conftest import make_scene, tilted_spinning_state
 from tests.oracle.body import BodyModel
 from tests.oracle.impact import impact_impulse
 from tests.oracle.lcp import delassus, moreau_lcp
@@ -104,10 +104,7 @@ CASES = list(_cases())
 def test_moreau_with_one_contact_is_eq_F(gamma, ground):
     scene = make_scene(n=5, gamma=gamma, ground=ground)
     model = BodyModel.from_scene(scene)
-    y = np.zeros(13)
-    y[3:7] = qt.from_rotation_vector([0.05, -0.08, 0.3])
-    y[7:10] = [0.1, -0.2, -0.9]
-    y[10:13] = [0.4, 0.3, 1.2]
+    y = tilted_spinning_state()
     _, _, W, u = delassus(model, y, [2])
     lam, u_post = _moreau(W, u, gamma)
     expected = impact_impulse(model, y, 2, gamma)

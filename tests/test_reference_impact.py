@@ -9,14 +9,11 @@ import pytest
 from reference import quaternion as qt
 from reference.core.impact import impact
 from reference.geometry import energies, scene_contact_kinematics
-from tests.conftest import core_model, make_scene
+from tests.conftest import core_model, make_scene, tilted_spinning_state
 
 
 def _state_on_contact(scene, k):
-    y = np.zeros(13)
-    y[3:7] = qt.from_rotation_vector([0.05, -0.08, 0.3])
-    y[7:10] = [0.1, -0.2, -0.9]
-    y[10:13] = [0.4, 0.3, 1.2]
+    y = tilted_spinning_state()
     gap = scene_contact_kinematics(scene, y)[0][0]
     y[2] -= gap[k]
     return y

@@ -18,7 +18,7 @@ from .floor import below_floor
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
-from .jit import copy_into, hot
+from .jit import copy_into, hot, sort_prefix
 from .law_event import law_event
 from .laws import LAW_PAPER
 from .output import push_accumulation, push_impact, push_sample
@@ -182,7 +182,7 @@ def activate(state, model, pts, ws, stats, landing, n_land):
         if new and m < ws.cand.shape[0]:
             ws.cand[m] = landing[i]
             m += 1
-    np_sort_prefix(ws.cand, m)
+    sort_prefix(ws.cand, m)
     n_held_before = state.n_active
     for i in range(n_held_before):
         ws.before[i] = state.active[i]
@@ -194,16 +194,6 @@ def activate(state, model, pts, ws, stats, landing, n_land):
         for i in range(m):
             state.active[i] = ws.cand[i]
     return True
-
-
-@hot
-def np_sort_prefix(a, m):
-    """Sort a[:m] in place (m ≤ 4)."""
-    for i in range(1, m):
-        j = i
-        while j > 0 and a[j - 1] > a[j]:
-            a[j - 1], a[j] = a[j], a[j - 1]
-            j -= 1
 
 
 @hot

@@ -31,3 +31,13 @@ def copy_into(dst, src):
     numba allocate a temporary in case they overlap, which needs its runtime."""
     for i in range(src.shape[0]):
         dst[i] = src[i]
+
+
+@hot
+def sort_prefix(a, m):
+    """Sort a[:m] in place (insertion sort: m, a count of contacts, is small)."""
+    for i in range(1, m):
+        k = i
+        while k > 0 and a[k - 1] > a[k]:
+            a[k - 1], a[k] = a[k], a[k - 1]
+            k -= 1

@@ -33,7 +33,7 @@ from .chatter import completion_speed
 from .clock import two_sum_add
 from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
 from .impact_laws import MAX_SEQUENTIAL_IMPACTS, SETTLED, TOO_MANY
-from .jit import hot
+from .jit import hot, sort_prefix
 from .law_dispatch import solve_law
 from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y
 from .multi_impact import apply_impulses, delassus_system
@@ -178,18 +178,8 @@ def touching_set(y, model, pts, named, n_named, contacts, separating):
                 return -1
             contacts[m] = c
             m += 1
-    _sort_prefix(contacts, m)
+    sort_prefix(contacts, m)
     return m
-
-
-@hot
-def _sort_prefix(a, m):
-    """Sort a[:m] in place (insertion: m is small)."""
-    for i in range(1, m):
-        j = i
-        while j > 0 and a[j - 1] > a[j]:
-            a[j - 1], a[j] = a[j], a[j - 1]
-            j -= 1
 
 
 @hot
