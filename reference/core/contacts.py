@@ -24,7 +24,7 @@ Accelerations `acc` are tuples (v̇x, v̇y, v̇z, ω̇x, ω̇y, ω̇z)."""
 
 import math
 
-from .jit import hot
+from .jit import hot, hot_inline
 from .layout import VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .records import KIND_COLUMN, RIM_VERTEX_ON_PLANE, Frame, Jet
 from .rotation import body_axis, rotation_columns_xy
@@ -71,9 +71,16 @@ def vertex_gap_noise(z, rz):
 
 @hot
 def bump_frame(y, bx, by, bz):
-    """Frame of the ground bump b under the body's face: gap d·e3 (d = x − b), normal e3,
-    lever −d + gap e3, roundoff GAP_NOISE_ULPS ε Σ|d_j e3_j|."""
-    ex, ey, ez = body_axis(y)
+    """Frame of the ground bump b under the body's face (`bump_frame_on_axis`)."""
+    return bump_frame_on_axis(y, body_axis(y), bx, by, bz)
+
+
+@hot
+def bump_frame_on_axis(y, e3, bx, by, bz):
+    """Frame of the ground bump b under the body's face, e3 = R ẑ the body's axis at
+    state y: gap d·e3 (d = x − b), normal e3, lever −d + gap e3, roundoff
+    GAP_NOISE_ULPS ε Σ|d_j e3_j|."""
+    ex, ey, ez = e3
     dx, dy, dz = y[X] - bx, y[Y] - by, y[Z] - bz
     gap = dx * ex + dy * ey + dz * ez
     noise = GAP_NOISE_ULPS * EPS * (abs(dx * ex) + abs(dy * ey) + abs(dz * ez))
@@ -86,6 +93,19 @@ def contact_frame(y, kind, pts, k):
     if kind == RIM_VERTEX_ON_PLANE:
         return vertex_frame(y, rotation_columns_xy(y), pts[k, 0], pts[k, 1])
     return bump_frame(y, pts[k, 0], pts[k, 1], pts[k, 2])
+
+
+@hot_inline
+def frame_at(y, cols, e3, kind, pts, k):
+    """`contact_frame` from R's first two columns and e3 at state y (cols:
+    `rotation.rotation_columns_xy`, e3: `rotation.body_axis`), computed once for the
+    contacts of a contact system: the same numbers, the attitude's terms not repeated
+    per contact.  Inlined where it is called (numba's IR inlining), as the contact
+    system's other per-contact functions (`normal_acceleration`), which LLVM left as
+    calls on the held motion's right-hand side."""
+    if kind == RIM_VERTEX_ON_PLANE:
+        return vertex_frame(y, cols, pts[k, 0], pts[k, 1])
+    return bump_frame_on_axis(y, e3, pts[k, 0], pts[k, 1], pts[k, 2])
 
 
 @hot
@@ -138,7 +158,7 @@ def bump_normal_acceleration(y, f, acc, bx, by, bz):
     return lin + 2.0 * (y[VX] * ux + y[VY] * uy + y[VZ] * uz) + dx * vx + dy * vy + dz * vz
 
 
-@hot
+@hot_inline
 def normal_acceleration(y, f, acc, kind, pts, k):
     """g″ of contact k (of kind `kind`, frame f) for accelerations acc."""
     if kind == RIM_VERTEX_ON_PLANE:

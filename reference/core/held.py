@@ -13,13 +13,13 @@ vertical angular momentum are untouched."""
 
 import numpy as np
 
-from .contacts import contact_frame, contact_kind, normal_acceleration, normal_velocity
-from .inertia import free_acceleration, impulse_response
-from .jit import hot
+from .contacts import contact_frame, contact_kind, frame_at, normal_acceleration, normal_velocity
+from .inertia import free_acceleration, response_on_axis
+from .jit import hot, hot_inline
 from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .linalg import solve_small
 from .records import SCRATCH
-from .rotation import quaternion_rate, rotate_attitude
+from .rotation import body_axis, quaternion_rate, rotate_attitude, rotation_columns_xy
 from .tolerances import PROJECTION_PASSES
 
 # `work` in this module is a records.SCRATCH record: A (3 × 3), b, r, lam (3),
@@ -46,15 +46,20 @@ def _row_dot(geo, i, resp, j):
     )
 
 
-@hot
+@hot_inline
 def contact_system(y, model, pts, idx, m, acc, work):
     """work.A = J M⁻¹ Jᵀ, work.b = J acc + bias (normal accelerations without contact
     forces when acc is the free acceleration), work.resp rows = M⁻¹J_iᵀ and w_i, for
-    the contacts idx[:m]."""
+    the contacts idx[:m] (the attitude's terms once for all: `contacts.frame_at`).
+    Inlined where it is called (numba's IR inlining), as the functions of the held
+    motion's right-hand side below it: an evaluation is one call (calls between them
+    made `triangle-chatter` under `moreau`, a run of 37 contact phases, 11 % slower;
+    benchmarks/law_speed.py)."""
+    cols, e3 = rotation_columns_xy(y), body_axis(y)
     for i in range(m):
         kind = contact_kind(pts, idx[i])
-        f = contact_frame(y, kind, pts, idx[i])
-        rsp = impulse_response(y, f, model.mass, model.i1, model.i3)
+        f = frame_at(y, cols, e3, kind, pts, idx[i])
+        rsp = response_on_axis(f, e3, model.mass, model.i1, model.i3)
         work.resp[i, 0], work.resp[i, 1], work.resp[i, 2] = rsp.dvx, rsp.dvy, rsp.dvz
         work.resp[i, 3], work.resp[i, 4], work.resp[i, 5] = rsp.dwx, rsp.dwy, rsp.dwz
         work.resp[i, 6] = rsp.w
@@ -66,7 +71,7 @@ def contact_system(y, model, pts, idx, m, acc, work):
             work.A[i, j] = work.resp[i, 6] if i == j else _row_dot(work.geo, i, work.resp, j)
 
 
-@hot
+@hot_inline
 def held_forces(y, model, pts, idx, m, work):
     """Normal forces λ (into work.lam) that keep contacts idx[:m] at zero normal
     acceleration: A λ = −b.  Returns the free acceleration and whether A was regular."""
@@ -77,7 +82,7 @@ def held_forces(y, model, pts, idx, m, work):
     return acc, solve_small(work.A, work.r, m, work.lam)
 
 
-@hot
+@hot_inline
 def held_acceleration(y, model, pts, idx, m, work):
     """(v̇, ω̇) with contacts idx[:m] held (forces may be negative: that is the lift-off
     signal); the free acceleration when m = 0."""
@@ -85,7 +90,7 @@ def held_acceleration(y, model, pts, idx, m, work):
     return add_responses(acc, work, m)
 
 
-@hot
+@hot_inline
 def add_responses(start, work, m):
     """start + Σ_i work.lam[i] M⁻¹J_iᵀ over the first m contacts of the contact system
     (their responses in work.resp): the change of (v, ω) that normal impulses λ_i make,

@@ -20,10 +20,16 @@ def impulse_response(y, f, mass, i1, i3):
     """M⁻¹Jᵀ and w = J M⁻¹ Jᵀ for the contact with frame f, J = [nᵀ, (r × n)ᵀ]: a normal
     impulse ζ changes v by ζ n/m, ω by ζ I⁻¹(r × n), the normal velocity by ζ w
     (the denominator of the paper's eq. F)."""
+    return response_on_axis(f, body_axis(y), mass, i1, i3)
+
+
+@hot
+def response_on_axis(f, e3, mass, i1, i3):
+    """`impulse_response` with e3 = R ẑ, the body's axis at the state, given."""
     cx = f.ry * f.nz - f.rz * f.ny
     cy = f.rz * f.nx - f.rx * f.nz
     cz = f.rx * f.ny - f.ry * f.nx
-    e3x, e3y, e3z = body_axis(y)
+    e3x, e3y, e3z = e3
     ix, iy, iz = inverse_inertia(e3x, e3y, e3z, i1, i3, cx, cy, cz)
     w = (f.nx * f.nx + f.ny * f.ny + f.nz * f.nz) / mass + cx * ix + cy * iy + cz * iz
     return Response(f.nx / mass, f.ny / mass, f.nz / mass, ix, iy, iz, w)
