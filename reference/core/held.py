@@ -54,12 +54,16 @@ def contact_system(y, model, pts, idx, m, acc, work):
     Inlined where it is called (numba's IR inlining), as the functions of the held
     motion's right-hand side below it: an evaluation is one call (calls between them
     made `triangle-chatter` under `moreau`, a run of 37 contact phases, 11 % slower;
-    benchmarks/law_speed.py)."""
+    benchmarks/law_speed.py).  The attitude's terms and the mass properties are read
+    before the loop stores anything: LLVM cannot tell the stores into `work` from the
+    state and the model (one record), and would read and compute them again per
+    contact."""
     cols, e3 = rotation_columns_xy(y), body_axis(y)
+    mass, i1, i3 = model.mass, model.i1, model.i3
     for i in range(m):
         kind = contact_kind(pts, idx[i])
         f = frame_at(y, cols, e3, kind, pts, idx[i])
-        rsp = response_on_axis(f, e3, model.mass, model.i1, model.i3)
+        rsp = response_on_axis(f, e3, mass, i1, i3)
         work.resp[i, 0], work.resp[i, 1], work.resp[i, 2] = rsp.dvx, rsp.dvy, rsp.dvz
         work.resp[i, 3], work.resp[i, 4], work.resp[i, 5] = rsp.dwx, rsp.dwy, rsp.dwz
         work.resp[i, 6] = rsp.w
@@ -109,7 +113,16 @@ def add_responses(start, work, m):
 
 @hot
 def held_rhs(y, model, pts, idx, m, work, dy):
-    """dy/dt of the held motion into dy (forces in work.lam)."""
+    """dy/dt of the held motion into dy (forces in work.lam): `held_derivative` in a
+    call of its own."""
+    held_derivative(y, model, pts, idx, m, work, dy)
+
+
+@hot_inline
+def held_derivative(y, model, pts, idx, m, work, dy):
+    """dy/dt of the held motion into dy (forces in work.lam).  Inlined where it is
+    called (numba's IR inlining): the stages of an integrator step
+    (dop853.dop853_step); `held_rhs` elsewhere."""
     acc = held_acceleration(y, model, pts, idx, m, work)
     dy[X], dy[Y], dy[Z] = y[VX], y[VY], y[VZ]
     dy[QW], dy[QX], dy[QY], dy[QZ] = quaternion_rate(y)
