@@ -145,9 +145,25 @@ def test_default_report_fits_100_columns_and_wide_has_every_column(calls):
     assert max(len(line) for line in text.splitlines()) <= 100
     wide = C.format_compare(result, wide=True)
     header = next(line for line in wide.splitlines() if line.startswith("engine"))
-    for column in ("status", "tails", "t_err[s]", "E_err", "att_err[rad]", "e_eff", "c"):
-        assert column in header.split()
+    columns = ("status", "matched  of", "ref skipped  run skipped", "t error [s]", "E error",
+               "attitude error [rad]", "e_eff  e_eff impacts", "c  c stderr")  # fmt: skip
+    for column in columns:
+        assert column in header
     assert max(len(line) for line in wide.splitlines()) > 100
+
+
+def test_wide_cells_hold_one_number_each(calls):
+    """matched and of, the skipped tails of the reference and of the run, e_eff and its
+    impacts are columns of their own: no cell of the wide table reads 'k/N' or 'n='."""
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    lines = C.format_compare(result, wide=True).splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("engine"))
+    row = lines[header + 2]
+    assert "/" not in row and "n=" not in row
+    m = result.runs[0].metrics
+    cells = row.split()
+    assert cells[5:9] == [str(m.impacts_matched), str(m.reference_impacts),
+                          str(m.skipped_reference), str(m.skipped_run)]  # fmt: skip
 
 
 def test_report_names_who_diverges_first_when_and_why(monkeypatch):
