@@ -7,7 +7,7 @@ import math
 import textwrap
 from typing import Any
 
-from ..text import num, table
+from ..text import column_tables, num, table
 
 WIDTH = 100
 LADDER_SPACED = 30  # up to this many scales the ladder's characters are spaced
@@ -215,28 +215,11 @@ def _ladder(doc: dict[str, Any]) -> str:
     lines = [
         "each scale, largest α first: the leading impacts each run matches, of the reference's "
         f"`of`\n(a run passes with at least {fraction:.0%} of them); skipped: predicted over "
-        "the time budget; -: not assessed"
+        "the time budget; -: not assessed",
+        *column_tables(head, fixed, columns, "rrr"),
     ]
-    for chunk in _column_chunks(columns, fixed, head):
-        rows = [[*f, *(c[1][i] for c in chunk)] for i, f in enumerate(fixed)]
-        lines.append(table(rows, [*head, *(c[0] for c in chunk)], "rrr" + "r" * len(chunk)))
     lines += _verdict_notes(groups)
     return "\n".join(lines)
-
-
-def _column_chunks(columns, fixed, head) -> list[list]:
-    """The runs' columns in groups whose table (beside the fixed columns) fits WIDTH."""
-    width = sum(max(len(h), *(len(r[i]) for r in fixed)) + 2 for i, h in enumerate(head))
-    chunks: list[list] = [[]]
-    used = width
-    for name, cells in columns:
-        w = max(len(name), *(len(c) for c in cells)) + 2
-        if chunks[-1] and used + w > WIDTH:
-            chunks.append([])
-            used = width
-        chunks[-1].append((name, cells))
-        used += w
-    return [c for c in chunks if c]
 
 
 def _verdict_notes(groups) -> list[str]:
