@@ -322,3 +322,36 @@ def test_linear_model_matches_the_reference_at_tiny_inclination_through_chatter(
     assert m.impacts_matched > 100
     assert m.impact_time_error < 1e-6 * result.reference.t_final
     assert m.first_divergence_time is None
+
+
+def test_the_horizon_table_gives_the_10_and_90_percent_values_in_columns_of_their_own(
+    monkeypatch,
+):
+    """The grid model's and the perturbed model's 10 % and 90 % matched counts, each a
+    cell, in the default report and in --wide (no '15–22' range to decode)."""
+    from harness.horizon.verdict import Horizon
+
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
+        traj = stand_in(engine, dt)
+        if engine == "mujoco":  # its second impact 0.1 s late: it diverges
+            traj.impacts[1] = ImpactEvent(0.7, 1, 1.0, -0.5, 0.25)
+        return traj
+
+    monkeypatch.setattr(C, "run_simulator", fake)
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco", "linear"], dts=[1e-3])
+    mujoco, linear = result.runs
+    mujoco.horizon = Horizon(2, [1.0, 2.0, 3.0], 1e-3, 0, [4.0, 5.0, 7.0], None, 0.1, 24, 0, 1e-3)
+    linear.horizon = Horizon(2, None, 2e-3, 0, [6.0, 6.0, 8.0], None, 0.1, 24, 0, None)
+    lines = C.format_compare(result).splitlines()
+    top = next(
+        i for i, line in enumerate(lines) if line.startswith("simulator  ") and "grid" in line
+    )
+    assert lines[top].split() == ["simulator", "matched", "grid", "10", "%", "grid", "90", "%",
+                                  "within", "own", "error", "perturbed", "10", "%", "perturbed",
+                                  "90", "%"]  # fmt: skip
+    assert lines[top + 2].split() == ["mujoco", "1e-03", "2", "1", "3", "yes", "1.0e-03", "4", "7"]
+    assert lines[top + 3].split() == ["linear", "2", "-", "-", "-", "2.0e-03", "6", "8"]
+    assert not any("–" in line for line in lines[top : top + 4])
+    wide = C.format_compare(result, wide=True).splitlines()
+    header = next(i for i, line in enumerate(wide) if line.startswith("engine"))
+    assert wide[header + 2].split()[-6:] == ["1", "3", "yes", "1.0e-03", "4", "7"]

@@ -307,7 +307,8 @@ def study(scene, engines: list[str], dts: list[float | None], t_end: float | Non
             if progress:
                 progress(f"branches: {engine} dt={dt}")
             if bar is not None:
-                bar.set_postfix_str(f"{scene.name}: {engine} dt={dt}", refresh=False)
+                now = engine if dt is None else f"{engine} dt={dt:g}"
+                bar.set_postfix_str(f"{scene.name}: {now}", refresh=False)
             if dt not in starts:
                 starts[dt] = engine_start(scene, t_u, y_u, y0, lead, after, dt, contacts)
             y_dt, outcomes_dt = starts[dt] if starts[dt][1] is not None else (y0, outcomes)
