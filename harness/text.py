@@ -50,7 +50,7 @@ def format_simulate(
                     [f"{ev.t:.15f}", label(ev.contact), f"{ev.impulse:.6e}"]
                     for ev in traj.impacts[:8]
                 ],
-                ["t [s]", "contact", "impulse"],
+                ["t [s]", "contact", "impulse [N s]"],
                 align="rrr",
             )
         )

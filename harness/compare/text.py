@@ -52,12 +52,6 @@ def contact_name(scene: Scene, k: int | None) -> str:
     return scene.contacts.label(int(k))
 
 
-def _exponent_cell(fit) -> str:
-    if fit is None or fit.c is None:
-        return "-"
-    return f"{fit.c:.2f}±{fit.c_stderr:.1g}"
-
-
 def _count_range(q: list[float]) -> str:
     """'15–22' from [10 %, 50 %, 90 %] quantiles of matched counts ('15' when equal):
     the sentences' range (the tables give the 10 % and 90 % values in two columns)."""
@@ -215,14 +209,16 @@ def _reference_counts(result: CompareResult) -> list[int]:
 
 def _verdict_table(result: CompareResult) -> str:
     """One row per run: how many of the reference's impacts it reproduces, when and why
-    it leaves them, its energy error while it follows and its wall time.  Columns that
-    are empty on every row (no chatter tail skipped, no exponent) are left out; when
-    every run is measured against the same number of reference impacts, the sentence
-    above the table gives it and the `of` column is left out too."""
+    it leaves them, its energy error while it follows, its energy exponent and its
+    standard error, and its wall time.  Columns that are empty on every row (no chatter
+    tail skipped, no exponent) are left out; when every run is measured against the same
+    number of reference impacts, the sentence above the table gives it and the `of`
+    column is left out too."""
     rows = []
     for run in result.runs:
-        m = run.metrics
+        m, fit = run.metrics, run.exponent
         t_div = m.first_divergence_time
+        has_c = fit is not None and fit.c is not None
         rows.append(
             [
                 run.label,
@@ -232,22 +228,23 @@ def _verdict_table(result: CompareResult) -> str:
                 "-" if t_div is None else f"{t_div:.5g}",
                 divergence_short(run, result.scene),
                 _num(m.energy_error_agreeing),
-                _exponent_cell(run.exponent),
+                f"{fit.c:.2f}" if has_c else "-",
+                _num(fit.c_stderr, ".1g") if has_c else "-",
                 f"{run.wall_time_s:.2g}",
             ]
         )
     header = ["simulator", "matched", "skipped", "of", "diverges at [s]",
-              "first disagreement", "E error", "c", "wall [s]"]  # fmt: skip
-    align = "lrrrrlrrr"
+              "first disagreement", "E error", "c", "c stderr", "wall [s]"]  # fmt: skip
+    align = "lrrrrlrrrr"
     drop = {2} if all(r[2] == "0" for r in rows) else set()
-    drop |= {7} if all(r[7] == "-" for r in rows) else set()
+    drop |= {7, 8} if all(r[7] == "-" for r in rows) else set()
     drop |= {3} if len(_reference_counts(result)) == 1 else set()
     # when the table is wider than WIDTH (long engine names beside an exponent): the wall
     # time left out, then the exponent, each with a note (--wide has every column)
     attempts = (
         (set(), ""),
-        ({8}, "\n(wall time left out to stay within 100 columns: --wide has it)"),
-        ({8, 7}, "\n(wall time and c left out to stay within 100 columns: --wide has them)"),
+        ({9}, "\n(wall time left out to stay within 100 columns: --wide has it)"),
+        ({9, 7, 8}, "\n(wall time and c left out to stay within 100 columns: --wide has them)"),
     )
     for extra, note in attempts:
         keep = [i for i in range(len(header)) if i not in drop | extra]
@@ -363,7 +360,9 @@ def legend(result: CompareResult) -> str:
         parts.append("skipped: slow chatter-tail bounces of the reference passed over on the way.")
     parts.append("E error: max|E − E_ref|/E_ref(0) while the run follows the reference.")
     if any(run.exponent is not None and run.exponent.c is not None for run in result.runs):
-        parts.append("c: energy exponent ± its standard error (runs that reach the singularity).")
+        parts.append(
+            "c: energy exponent, c stderr: its standard error (runs that reach the singularity)."
+        )
     parts.append(
         "v2 = rim vertex 2, b2 = bump 2. Every column: --wide; definitions: docs/output.md."
     )

@@ -26,20 +26,6 @@ def alpha_star_text(star: dict[str, Any]) -> str:
     return "-"
 
 
-def fit_text(fit: dict[str, Any]) -> str:
-    """'2.00 ± 0.05, grid 1.75..2.25 (3 dts)'; without a standard error with 2 dts; '-'
-    with fewer (the HTML report's cell)."""
-    if fit["k"] is None:
-        return "-"
-    text = f"{fit['k']:.2f}"
-    if fit["k_stderr"] is not None:
-        text += f" ± {fit['k_stderr']:.2f}"
-    if fit.get("k_grid"):
-        lo, hi = fit["k_grid"]
-        text += f", grid {lo:.2f}..{hi:.2f}"
-    return text + f" ({fit['n_points']} dts)"
-
-
 FIT_HEADER = ["k", "k stderr", "k min", "k max", "dts"]
 
 
@@ -172,16 +158,6 @@ def _horizon_table(doc: dict[str, Any], dts: list[float | None]) -> str:
         f"{doc.get('horizon_runs')} grid phases)\n"
         + table(rows, header, "l" + "r" * (len(header) - 1))
     )
-
-
-def ladder_cell(row: dict[str, Any]) -> str:
-    """Leading impacts matched, 'x' when the run fails, 's' skipped, '-' not assessed
-    (the HTML report's cell, coloured by the verdict)."""
-    if row["skipped"]:
-        return "s"
-    if row["passes"] is None:
-        return "-"
-    return f"{row['leading_matched']}{'' if row['passes'] else 'x'}"
 
 
 def matched_cell(row: dict[str, Any] | None) -> str:
