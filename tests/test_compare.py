@@ -146,7 +146,7 @@ def test_default_report_fits_100_columns_and_wide_has_every_column(calls):
     wide = C.format_compare(result, wide=True)
     header = next(line for line in wide.splitlines() if line.startswith("engine"))
     columns = ("status", "matched  of", "ref skipped  run skipped", "t error [s]", "E error",
-               "attitude error [rad]", "e_eff  e_eff impacts", "c  c stderr")  # fmt: skip
+               "attitude window [rad]", "e_eff  e_eff impacts", "c  c stderr")  # fmt: skip
     for column in columns:
         assert column in header
     assert max(len(line) for line in wide.splitlines()) > 100

@@ -398,10 +398,11 @@ def format_compare(result: CompareResult, wide: bool = False) -> str:
 
 
 WIDE_HEADER = ["engine", "dt [s]", "status", "wall [s]", "impacts", "matched", "of",
-               "ref skipped", "run skipped", "t error [s]", "E error", "E error following",
-               "attitude error [rad]", "attitude following [rad]", "diverges at [s]", "why",
-               "e_eff", "e_eff impacts", "c", "c stderr", "t_f from", "grid 10 %",
-               "grid 90 %", "within", "own error", "perturbed 10 %", "perturbed 90 %"]  # fmt: skip
+               "ref skipped", "run skipped", "t error [s]", "E error window",
+               "E error following", "attitude window [rad]", "attitude following [rad]",
+               "diverges at [s]", "why", "e_eff", "e_eff impacts", "c", "c stderr", "t_f from",
+               "grid 10 %", "grid 90 %", "within", "own error", "perturbed 10 %",
+               "perturbed 90 %"]  # fmt: skip
 WIDE_ALIGN = "lrlrrrrrrrrrrrrlrrrrlrrlrrr"
 WIDE_NOTES = (
     "matched: leading impacts with the reference's contact and time, |dt| <= "
@@ -411,9 +412,9 @@ WIDE_NOTES = (
     "ref skipped, run skipped: chatter-tail impacts of the reference and of the run passed "
     "over (approach slower than max(10 g dt, 1% of the fastest), at a contact already in "
     "the chatter episode).",
-    "E error: max |E - E_ref|/E_ref(0) away from impacts over the common window; attitude "
-    "error: the largest angle between the attitudes; following: the same before the first "
-    "divergence.",
+    "E error: max |E - E_ref|/E_ref(0) away from impacts; attitude: the largest angle "
+    "between the attitudes; window: over the common window; following: before the first "
+    "divergence (the default table's E error).",
     "diverges at: the first impact mismatch or attitude error > 0.1 x max reference tilt. "
     "e_eff: median -v_post/v_pre of the e_eff impacts, the run's impacts approaching "
     "faster than max(10 g dt, 1% of the fastest).",
