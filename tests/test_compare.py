@@ -347,8 +347,7 @@ def test_the_horizon_table_gives_the_10_and_90_percent_values_in_columns_of_thei
         i for i, line in enumerate(lines) if line.startswith("simulator  ") and "grid" in line
     )
     assert lines[top].split() == ["simulator", "matched", "grid", "10", "%", "grid", "90", "%",
-                                  "within", "own", "error", "perturbed", "10", "%", "perturbed",
-                                  "90", "%"]  # fmt: skip
+                                  "within", "own", "error", "own", "10", "%", "own", "90", "%"]  # fmt: skip
     assert lines[top + 2].split() == ["mujoco", "1e-03", "2", "1", "3", "yes", "1.0e-03", "4", "7"]
     assert lines[top + 3].split() == ["linear", "2", "-", "-", "-", "2.0e-03", "6", "8"]
     assert not any("–" in line for line in lines[top : top + 4])
