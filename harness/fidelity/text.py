@@ -10,7 +10,6 @@ from typing import Any
 from ..text import column_tables, num, table
 
 WIDTH = 100
-LADDER_SPACED = 30  # up to this many scales the ladder's characters are spaced
 
 
 def alpha_star_text(star: dict[str, Any]) -> str:
