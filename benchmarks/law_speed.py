@@ -6,10 +6,10 @@
 Each round runs, in a fresh process per tree (the trees alternating, so that both see
 the same load), each scene `repeats` times per law after an untimed warm-up run, and
 keeps stats.impacts_per_s of every run.  Per scene and law the table gives, per tree,
-the median over rounds of the rounds' medians; the ratio of this tree to OTHER_TREE
-(median over rounds of the rounds' ratios of medians, and their min … max); and the
-ratio of the rounds' best runs (median over rounds: the least disturbed runs of a
-shared machine).  The load average before and after is printed with it.  Each tree
+the median over rounds of the rounds' medians (for this tree also their min … max);
+the ratio of this tree to OTHER_TREE (median over rounds of the rounds' ratios of
+medians, and their min … max); and the ratio of the rounds' best runs (median over
+rounds: the least disturbed runs of a shared machine).  The load average before and after is printed with it.  Each tree
 runs its own compiled core (build it first: `python -m reference.core.aot`).  A
 benchmark, not a test: nothing here asserts a speed.
 """
@@ -66,6 +66,7 @@ def summary(this: list[dict], other: list[dict]) -> dict:
     return {
         "other": statistics.median(med_a),
         "this": statistics.median(med_b),
+        "this_range": (min(med_b), max(med_b)),
         "ratio": statistics.median(ratios),
         "low": min(ratios),
         "high": max(ratios),
@@ -92,14 +93,15 @@ def main(argv: list[str] | None = None) -> int:
           f"{args.repeats} runs; load average (1, 5, 15 min) "
           f"{'/'.join(f'{x:.1f}' for x in load0)} before, "
           f"{'/'.join(f'{x:.1f}' for x in load1)} after")  # fmt: skip
-    print(f"{'scene':20} {'law':10} {'other':>9} {'this':>9} {'ratio':>6} "
-          f"{'min..max':>13} {'best':>6}  impacts")  # fmt: skip
+    print(f"{'scene':18} {'law':7} {'other':>7} {'this':>7} {'this min..max':>15} "
+          f"{'ratio':>6} {'min..max':>13} {'best':>6}  impacts")  # fmt: skip
     for key in rounds["this"][0]:
         s = summary([x[key] for x in rounds["this"]], [x[key] for x in rounds["other"]])
         last, last_other = rounds["this"][-1][key], rounds["other"][-1][key]
         scene, law = key.rsplit(" ", 1)
-        print(f"{scene:20} {law:10} {s['other']:9.0f} {s['this']:9.0f} {s['ratio']:6.3f} "
-              f"{s['low']:6.3f}..{s['high']:<6.3f} {s['best']:6.3f}  "
+        lo, hi = s["this_range"]
+        print(f"{scene:18} {law:7} {s['other']:7.0f} {s['this']:7.0f} {lo:7.0f}..{hi:<7.0f}"
+              f" {s['ratio']:6.3f} {s['low']:6.3f}..{s['high']:<6.3f} {s['best']:6.3f}  "
               f"{last['impacts']} ({last['simultaneous']} simultaneous, {last['status']}; "
               f"other: {last_other['impacts']}, {last_other['status']})")  # fmt: skip
     return 0

@@ -112,11 +112,12 @@ def _needed(n_grid, out, opts):
     return need > out.sample_t.shape[0] - n
 
 
-@hot
+@hot_inline
 def flight_step(state, model, pts, opts, stats, out, ws, cs):
     """Free flight from the state to its first event (or to t_end), then the event; the
     rim reaching the floor plane first (a ground without rim contacts, `floor.floor_reach`)
-    ends the run there, `left_model`."""
+    ends the run there, `left_model`.  Inlined where it is called (numba's IR inlining:
+    the loop's step, `loop.loop_step`)."""
     y = state.y
     remaining = time_until(state.t_hi, state.t_lo, opts.t_end)
     fc = flight_constants(y, model.i1, model.i3)
