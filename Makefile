@@ -67,12 +67,15 @@ demo: $(BUILD_DEPS)
 # every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
 # engine whose extra is missing has its tests skipped with the reason, and under CI=true
 # (.ci/run) such a skip fails the run (tests/conftest.py)
+# The suite starts hundreds of Python processes (every worker, every CLI test): byte-code
+# caches are written even where the environment sets PYTHONDONTWRITEBYTECODE, so that each
+# process reads the project's modules (and pytest its rewritten tests) compiled once.
 TEST_WORKERS ?= auto
 test: setup
-	$(BIN)/python -m pytest -n $(TEST_WORKERS)
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS)
 
 test-slow: setup
-	$(BIN)/python -m pytest -m slow
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -m slow
 
 lint: $(STAMP_ALL)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
