@@ -9,9 +9,10 @@ keeps stats.impacts_per_s of every run.  Per scene and law the table gives, per 
 the median over rounds of the rounds' medians (for this tree also their min … max);
 the ratio of this tree to OTHER_TREE (median over rounds of the rounds' ratios of
 medians, and their min … max); and the ratio of the rounds' best runs (median over
-rounds: the least disturbed runs of a shared machine).  The load average before and after is printed with it.  Each tree
-runs its own compiled core (build it first: `python -m reference.core.aot`).  A
-benchmark, not a test: nothing here asserts a speed.
+rounds: the least disturbed runs of a shared machine).  The load average before and
+after is printed with it.  Each tree runs its own compiled core (build it first:
+`python -m reference.core.aot`).  A benchmark, not a test: nothing here asserts a
+speed.
 """
 
 from __future__ import annotations
