@@ -62,6 +62,15 @@ def tilted_spinning_state() -> np.ndarray:
 
 
 @pytest.fixture
+def no_sweep_figures(monkeypatch):
+    """Sweeps that skip their PNGs (2-3 s each): for tests of a sweep's input and
+    rows; the README commands test and test_sweep's resumed run draw the figures."""
+    import harness.sweep.plots
+
+    monkeypatch.setattr(harness.sweep.plots, "make_sweep_figures", lambda *a, **k: {})
+
+
+@pytest.fixture
 def scene_factory():
     return make_scene
 
