@@ -76,7 +76,7 @@ def test_rim_at_gives_the_oracle_flights_axis_and_its_rate(seed):
             assert np.linalg.norm(second) <= cone[7] * (1 + 1e-3) + 1e-3
 
 
-# seeds 1 and 2 repeat seed 0's check on other flights (≈ 20 s each): `-m slow`
+# seeds 1 and 2 repeat seed 0's check on other flights (≈ 14 s of CPU each): `-m slow`
 RIM_SEEDS = [0, *(pytest.param(s, marks=pytest.mark.slow) for s in (1, 2))]
 
 
