@@ -1,17 +1,26 @@
 """Shared fixtures: scenes built in code (independent of the shipped TOML files), and the
 rule for engines that come with a pip extra: their tests are skipped with a one-line reason
 where the extra is missing (`require_extra`), and a CI run (environment CI=true, .ci/run)
-fails when any of them was skipped, since CI installs every extra (`make test`)."""
+fails when any of them was skipped, since CI installs every extra (`make test`).
+
+JAX keeps what it compiles (the MJX engine's scans, ~10 s of CPU each) in .cache/jax at
+the repository's root, as numba keeps the core's functions in __pycache__: a test run
+after the first, and a second worker of the same run, load them instead of compiling."""
 
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from reference import quaternion as qt
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
+
+os.environ.setdefault(
+    "JAX_COMPILATION_CACHE_DIR", str(Path(__file__).resolve().parents[1] / ".cache" / "jax")
+)
 
 
 def make_scene(
@@ -59,6 +68,15 @@ def tilted_spinning_state() -> np.ndarray:
     y[7:10] = [0.1, -0.2, -0.9]
     y[10:13] = [0.4, 0.3, 1.2]
     return y
+
+
+@pytest.fixture
+def no_sweep_figures(monkeypatch):
+    """Sweeps that skip their PNGs (2-3 s each): for tests of a sweep's input and
+    rows; the README commands test and test_sweep's resumed run draw the figures."""
+    import harness.sweep.plots
+
+    monkeypatch.setattr(harness.sweep.plots, "make_sweep_figures", lambda *a, **k: {})
 
 
 @pytest.fixture

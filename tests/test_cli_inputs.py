@@ -281,7 +281,9 @@ def test_force_replaces_an_output_atomically_and_leaves_no_temporary(cli):
 # ----------------------------------------------------------------------------- sweeps
 
 
-def test_a_grid_too_large_is_refused_before_the_manifest_and_the_fix_then_runs(cli):
+def test_a_grid_too_large_is_refused_before_the_manifest_and_the_fix_then_runs(
+    cli, no_sweep_figures
+):
     huge = ["--gyration", "0.1:0.5:10000", "--restitution", "0:0.5:10000"]
     base = ["sweep", "exponent", "--samples", "1", "--out", "sw"]
     assert_bad_input(cli, [*base, *huge], fragment="at most")

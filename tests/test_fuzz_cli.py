@@ -25,7 +25,6 @@ import os
 import tempfile
 from pathlib import Path
 
-import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
@@ -259,15 +258,6 @@ FUZZ = settings(
     database=None,
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
 )
-
-
-@pytest.fixture
-def no_sweep_figures(monkeypatch):
-    """The sweeps here skip their PNGs (2-3 s each, the bulk of this module's time):
-    what is fuzzed is the input; the README commands test draws a sweep's figures."""
-    import harness.sweep.plots
-
-    monkeypatch.setattr(harness.sweep.plots, "make_sweep_figures", lambda *a, **k: {})
 
 
 @settings(FUZZ, max_examples=EXAMPLES["event-driven"])

@@ -78,8 +78,11 @@ def _product_event(scene, y, window):
 
 
 @pytest.mark.parametrize(
-    "n,count", [(20, 40), (24, 40), (33, 40), (100, 40), (1000, 20), (10_000, 6)]
-)
+    "n,count",
+    # n = 10,000 repeats n = 1,000's check at ten times its cost: `-m slow`
+    [(20, 40), (24, 40), (33, 40), (100, 40), (1000, 20),
+     pytest.param(10_000, 6, marks=pytest.mark.slow)],
+)  # fmt: skip
 def test_large_n_window_search_finds_the_event_of_every_vertex_search(n, count):
     """For n > SMALL_N (19) the search examines only a window of vertices near the lowest
     direction and bounds the rest by the circle through them.  Against the same search

@@ -162,7 +162,7 @@ def test_other_parameters_in_the_same_directory_are_refused(local_run):
         exponent_sweep(small_config(samples=7), out, figures=False, bar=False)
 
 
-def test_cli_reports_bad_sweep_input_as_exit_status_2(tmp_path, capsys):
+def test_cli_reports_bad_sweep_input_as_exit_status_2(tmp_path, capsys, no_sweep_figures):
     from harness.cli import main
 
     base = ["sweep", "exponent", "--gyration", "0.2", "--samples", "1", "--out", str(tmp_path)]
