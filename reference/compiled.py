@@ -20,6 +20,8 @@ from pathlib import Path
 CORE_DIR = Path(__file__).with_name("core")
 AOT_MODULE = "reference.core._aot"
 STAMP_FILE = CORE_DIR / "_aot.stamp"
+# the folders whose njit functions numba caches on disk (in their __pycache__)
+JIT_CACHED = (CORE_DIR, CORE_DIR.parent / "linear")
 
 # exported function → the core module that defines it
 EXPORTS = {
@@ -73,26 +75,38 @@ def fresh_aot_module():
         return None
 
 
-def _clear_stale_jit_cache() -> None:
+def _jit_sources_stamp() -> str:
+    """SHA-256 of the source files whose machine code numba caches: the core's and the
+    linear model's (its kernel calls the core's functions)."""
+    h = hashlib.sha256()
+    for folder in JIT_CACHED:
+        for path in sorted(folder.glob("*.py")):
+            h.update(f"{folder.name}/{path.name}".encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def clear_stale_jit_cache() -> None:
     """numba's cache does not notice that a function called from another module has
-    changed; after any change to the core's sources its cached machine code is dropped
-    (the stamp of the sources it was compiled from is kept beside it)."""
+    changed; after any change to the core's or the linear model's sources the cached
+    machine code of both is dropped (the stamp of the sources it was compiled from is
+    kept beside the core's cache).  Called before the first compiled call of either."""
     global _cache_checked
     if _cache_checked:
         return
     _cache_checked = True
-    cache = CORE_DIR / "__pycache__"
-    stamp_file = cache / "jit.stamp"
-    stamp = source_stamp()
+    stamp_file = CORE_DIR / "__pycache__" / "jit.stamp"
+    stamp = _jit_sources_stamp()
     try:
         if stamp_file.read_text().strip() == stamp:
             return
     except OSError:
         pass
-    for path in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
-        path.unlink(missing_ok=True)
+    for cache in (folder / "__pycache__" for folder in JIT_CACHED):
+        for path in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
+            path.unlink(missing_ok=True)
     try:
-        cache.mkdir(exist_ok=True)
+        stamp_file.parent.mkdir(exist_ok=True)
         stamp_file.write_text(stamp + "\n")
     except OSError:
         pass
@@ -107,7 +121,7 @@ def _aot_module():
 
 def jit_function(name: str):
     """The just-in-time (numba) version of an exported function."""
-    _clear_stale_jit_cache()
+    clear_stale_jit_cache()
     module = importlib.import_module(f"reference.core.{EXPORTS[name]}")
     return getattr(module, name)
 

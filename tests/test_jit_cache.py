@@ -1,0 +1,61 @@
+"""numba's on-disk cache is dropped when a source it depends on changes: a change in the
+core's or the linear model's sources drops the cached machine code of both (numba itself
+only notices a change in the file that defines the cached function)."""
+
+from __future__ import annotations
+
+import pytest
+
+from reference import compiled
+
+
+@pytest.fixture
+def sources(tmp_path, monkeypatch):
+    """Two source folders, core/ and linear/, each with a module and a numba cache."""
+    core, linear = tmp_path / "core", tmp_path / "linear"
+    for folder in (core, linear):
+        (folder / "__pycache__").mkdir(parents=True)
+        (folder / "m.py").write_text("x = 1\n")
+    monkeypatch.setattr(compiled, "CORE_DIR", core)
+    monkeypatch.setattr(compiled, "JIT_CACHED", (core, linear))
+    return core, linear
+
+
+def cache_files(folder):
+    return sorted(p.name for p in (folder / "__pycache__").glob("*.nb[ic]"))
+
+
+def fill(folder):
+    for name in ("m.f-1.py311.nbi", "m.f-1.py311.1.nbc"):
+        (folder / "__pycache__" / name).write_bytes(b"machine code")
+
+
+def check(monkeypatch):
+    monkeypatch.setattr(compiled, "_cache_checked", False)
+    compiled.clear_stale_jit_cache()
+
+
+def test_a_cache_of_the_same_sources_is_kept(sources, monkeypatch):
+    core, linear = sources
+    check(monkeypatch)  # no stamp yet: writes it
+    fill(core), fill(linear)
+    check(monkeypatch)
+    assert len(cache_files(core)) == 2 and len(cache_files(linear)) == 2
+
+
+def test_a_changed_core_source_drops_the_linear_models_cache_too(sources, monkeypatch):
+    core, linear = sources
+    check(monkeypatch)
+    fill(core), fill(linear)
+    (core / "m.py").write_text("x = 2\n")
+    check(monkeypatch)
+    assert cache_files(core) == [] and cache_files(linear) == []
+
+
+def test_a_changed_linear_source_drops_its_cache(sources, monkeypatch):
+    core, linear = sources
+    check(monkeypatch)
+    fill(linear)
+    (linear / "m.py").write_text("x = 2\n")
+    check(monkeypatch)
+    assert cache_files(linear) == []
