@@ -127,8 +127,13 @@ def undecided_message(law, outcome, t, contacts, hits=None):
     the single impacts it made, MAX_SEQUENTIAL_IMPACTS when not known): the message of
     the exact core's and the linear model's runs alike."""
     # here: the core's modules import numba (this runs only for such a run's message)
-    from .impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
-    from .impact_laws import TOO_MANY
+    from .impact_laws import (
+        MAX_LAW_CONTACTS,
+        MAX_SEQUENTIAL_IMPACTS,
+        NOT_SETTLED,
+        SINGULAR,
+        TOO_MANY,
+    )
     from .law_event import NO_PROGRESS
 
     if outcome == NOT_SETTLED:

@@ -11,8 +11,11 @@ positive root of one; roots are taken in cancellation-free form (`first_hit`).  
 - with a simultaneity window T > 0, open contacts reaching the ground
   within T of the one reached first are reached together with it: status SIMULTANEOUS
   (REASON_WINDOW) on the state where the first is reached, the others flagged in
-  `together` (their gaps, at most T|u|, not closed); an impact law resolves it
-  (laws.py);
+  `together` (their gaps, at most T|u|, not closed);
+- under an impact law (reference.core.laws) other than `paper`, a stop SIMULTANEOUS is
+  resolved by the law where it happens, inside the loop (`_law_event`: the exact core's
+  law functions on the Delassus matrix F_S Θ⁻¹ F_Sᵀ; a self-similar bounce series
+  completed in closed form), and the run goes on;
 - at every event the held set is re-solved: forces from F_B Θ⁻¹ F_Bᵀ η = g 1 over the
   subsets B of the closed contacts; the admissible one has η ≥ 0 and no closed contact
   with negative normal acceleration (an LCP by enumeration; rank(F) closed contacts is
@@ -49,8 +52,10 @@ small tuples and arrays, unpacked at their top:
 
     model   = (F, thd, tinv, w, wmax, mass, gamma, rank_f)   constants of the body
     limits  = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol, window,
-               together)   the run's limits; the simultaneity window T (0: none) and the
-              contacts it found reached together (an output, read by laws.py)
+               together, law)   the run's limits; the simultaneity window T (0: none), the
+              contacts it found reached together (those of an impact the law left
+              undecided, for the message) and the law's code
+    lawws   = (law_mats, law_vecs, law_ints, law_order)   the law's scratch
     state   = (q, p, qs, ps, acc, held, closed)   normalised state, roundoff scales of q
               and p, acceleration of the segment, held contacts, closed contacts
     scratch = (q_pre, p_pre, qn, pn, work, cidx, hidx, sidx)   work vectors, index lists
@@ -1232,45 +1237,39 @@ def _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, a):
 
 
 @_helper
-def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, vfl):
-    """After a law impact at q = 0 with every contact touching (p⁺ = p): the Zeno series
-    of self-similar bounces, completed in closed form when there is one (docs/laws.md,
-    "Self-similar bounce series").  With B the contacts resting after the impact held,
-    the acceleration a is constant; if a = −κp⁺ (κ > 0) every gap is f_cᵀp⁺ ≥ 0 times one
-    bouncing-ball profile and the body is back at q = 0 with p = −p⁺ after 2/κ; if the
-    law maps −p⁺ to γp⁺ (applied, to SELF_SIMILAR_TOL), every later flight is γ times the
-    one before.  Writes the bounces (bounce j at t + (2/κ)(1 − γʲ)/(1 − γ), impulses
-    and velocities × γ^(j−1)) while their energy is above the floor and within the
-    impact budget, then ends the run at rest (SINGULARITY, REASON_SINGULARITY,
-    info[INFO_SERIES]) at t + 2/(κ(1 − γ)), if before t_end.  Returns whether it did."""
+def _series_maps_back(model, law, p, contacts, k, lawws, pn, miss):
+    """Whether the law maps −p⁺ (p⁺ = p) to γp⁺ (to SELF_SIMILAR_TOL, in the Θ norm):
+    every bounce of the series is then the first × γ^(j−1).  Leaves the law's impulses,
+    u⁻ and u⁺ of the landing at −p⁺ in the scratch (those of the series' first bounce)."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
-    t_end, max_impacts, log2_floor = limits[0], limits[1], limits[2]
-    q, p, qs, ps, acc, held, closed = state
-    zero, pp, a, pn, pq = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
-    gt = sf[SF_GRAVITY]
-    nc = F.shape[0]
-    if not (0.0 < gamma < 1.0 and gt > 0.0) or k < nc:
-        return False
-    vecs, rest = lawws[1], lawws[2][2 * nc :]
-    kappa, m = _series_rate(model, p, contacts, k, vecs[2 * nc : 3 * nc], vfl, gt, rest, a)
-    if kappa == 0.0:
-        return False
     for i in range(3):
         pn[i] = -p[i]
-    status, _ = _law_impulses(model, limits[7], pn, contacts, k, gamma, lawws)
+    status, _ = _law_impulses(model, law, pn, contacts, k, gamma, lawws)
     if status != SETTLED:
         return False
-    lam = vecs[nc : 2 * nc]
-    _add_law_impulses(F, tinv, contacts, k, lam, pn)
+    nc = F.shape[0]
+    _add_law_impulses(F, tinv, contacts, k, lawws[1][nc : 2 * nc], pn)
     for i in range(3):
-        pq[i] = pn[i] - gamma * p[i]
-    if _theta_dot(thd, pq, pq) > SELF_SIMILAR_TOL**2 * _theta_dot(thd, p, p):
-        return False
-    flight = 2.0 / kappa
-    duration = flight / (1.0 - gamma)
-    kv, kq = si[SI_KV], si[SI_KQ]
-    if not sf[SF_T_HI] + math.ldexp(duration, kq - kv) <= t_end:
-        return False
+        miss[i] = pn[i] - gamma * p[i]
+    return _theta_dot(thd, miss, miss) <= SELF_SIMILAR_TOL**2 * _theta_dot(thd, p, p)
+
+
+@_helper
+def _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts, k, flight, m):
+    """The bounces of a self-similar series after the law impact at the current time, p⁺
+    = p (`_bounce_series`): bounce j at t + flight (1 − γʲ)/(1 − γ), one IMPACT row per
+    contact that takes an impulse, impulses and velocities those of the first × γ^(j−1),
+    while the energy before a bounce is above the floor and within the impact budget;
+    the held set of the rows: the m contacts left resting (lawws' rest).  Returns the
+    time of the last row."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    max_impacts, log2_floor = limits[1], limits[2]
+    q, p, qs, ps, acc, held, closed = state
+    zero, pp, a, pq = scratch[0], scratch[1], scratch[2], scratch[4]
+    nc = F.shape[0]
+    vecs, rest = lawws[1], lawws[2][2 * nc :]
+    lam = vecs[nc : 2 * nc]
+    kv, kq, gt = si[SI_KV], si[SI_KQ], sf[SF_GRAVITY]
     t0_hi, t0_lo = sf[SF_T_HI], sf[SF_T_LO]
     last_hi, last_lo = t0_hi, t0_lo
     for i in range(3):
@@ -1306,15 +1305,48 @@ def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, cont
                 dtn = 0.0
         n += took
         j += 1
+    return last_hi, last_lo
+
+
+@_helper
+def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, vfl):
+    """After a law impact at q = 0 with every contact touching (p⁺ = p): the Zeno series
+    of self-similar bounces, completed in closed form when there is one (docs/laws.md,
+    "Self-similar bounce series").  With B the contacts resting after the impact held,
+    the acceleration a is constant; if a = −κp⁺ (κ > 0) every gap is f_cᵀp⁺ ≥ 0 times one
+    bouncing-ball profile and the body is back at q = 0 with p = −p⁺ after 2/κ; if the
+    law maps −p⁺ to γp⁺, every later flight is γ times the one before.  Writes the
+    bounces (`_series_rows`), then ends the run at rest (SINGULARITY, REASON_SINGULARITY,
+    info[INFO_SERIES]) at t + 2/(κ(1 − γ)), if before t_end.  Returns whether it did."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    q, p, qs, ps, acc, held, closed = state
+    gt = sf[SF_GRAVITY]
+    nc = F.shape[0]
+    if not (0.0 < gamma < 1.0 and gt > 0.0) or k < nc:
+        return False
+    rest, u_post = lawws[2][2 * nc :], lawws[1][2 * nc : 3 * nc]
+    kappa, m = _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, scratch[2])
+    if kappa == 0.0:
+        return False
+    if not _series_maps_back(model, limits[7], p, contacts, k, lawws, scratch[3], scratch[4]):
+        return False
+    flight = 2.0 / kappa
+    duration = flight / (1.0 - gamma)
+    kv, kq = si[SI_KV], si[SI_KQ]
+    if not sf[SF_T_HI] + math.ldexp(duration, kq - kv) <= limits[0]:
+        return False
+    last_hi, last_lo = _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts,
+                                    k, flight, m)  # fmt: skip
     # at rest at t + 2/(κ(1 − γ)): the coordinates the contacts see are 0 (the rod's roll
     # about its axis, which they do not see, carried on for the tail)
     for i in range(3):
         q[i] = q[i] + p[i] * duration
     _project(q, F, tinv, contacts, min(k, 3))
     _project(p, F, tinv, contacts, min(k, 3))
-    t_hi, t_lo = _add_time(t0_hi, t0_lo, math.ldexp(duration, kq - kv))
+    t_hi, t_lo = _add_time(sf[SF_T_HI], sf[SF_T_LO], math.ldexp(duration, kq - kv))
     sf[SF_DT_PENDING] = math.ldexp((t_hi - last_hi) + (t_lo - last_lo), kv - kq)
-    sf[SF_T_HI], sf[SF_T_LO], sf[SF_SERIES_T] = t_hi, t_lo, t0_hi
+    sf[SF_SERIES_T] = sf[SF_T_HI]
+    sf[SF_T_HI], sf[SF_T_LO] = t_hi, t_lo
     info[INFO_SERIES] = 1
     _stop(si, info, SINGULARITY, REASON_SINGULARITY, -1, -1)
     return True
