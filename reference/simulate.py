@@ -20,7 +20,7 @@ import numpy as np
 from . import compiled
 from .checks import check_reference_options, run_horizon
 from .core import records as R
-from .core.laws import LAW_PAPER, law_code, law_of, undecided_message, work_floats
+from .core.laws import LAW_PAPER, law_code, law_of, work_floats
 from .core.records import (
     N_ACCUMULATIONS,
     N_IMPACTS,
@@ -355,6 +355,9 @@ def _law_name(md) -> str:
 
 def _law_undecided(st, md, t, cs) -> str:
     """Why the run's impact law left a simultaneous impact undecided (law_event)."""
+    # here: the core's modules import numba (this runs only for such a run's message)
+    from .core.law_message import undecided_message
+
     return undecided_message(_law_name(md), int(st["law_outcome"]), t, cs)
 
 

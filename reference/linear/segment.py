@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.laws import law_of_name, undecided_message, work_floats
+from ..core.law_message import undecided_message
+from ..core.laws import law_of_name, work_floats
 from ..trajectory import Status
 from . import kernel as K
 from .model import LinearModel
