@@ -104,7 +104,7 @@ def simulate_linear(
     from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
     max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
     listed in stats["accumulations"], not as impacts.  The scene's `impact_law` and
-    `simultaneity_window` apply (laws.py; docs/laws.md, "The linear model under the
+    `simultaneity_window` apply (kernel._law_event; docs/laws.md, "The linear model under the
     laws")."""
     from ..checks import check_linear_options, run_horizon
     from ..scenes import as_scene
