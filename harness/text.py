@@ -50,11 +50,42 @@ def format_simulate(
                     [f"{ev.t:.15f}", label(ev.contact), f"{ev.impulse:.6e}"]
                     for ev in traj.impacts[:8]
                 ],
-                ["t [s]", "contact", "impulse"],
+                ["t [s]", "contact", "impulse [N s]"],
                 align="rrr",
             )
         )
     return "\n".join(lines)
+
+
+def column_tables(
+    head: list[str],
+    fixed: list[list[str]],
+    columns: list[tuple[str, list[str]]],
+    align: str,
+    width: int = WIDTH,
+) -> list[str]:
+    """Tables of the rows `fixed` (header `head`, aligned by `align`) beside the named
+    `columns` (name, one cell a row; right-aligned), as many tables as needed for each
+    to fit `width` columns, each repeating the fixed columns."""
+    used = sum(max(len(h), *(len(r[i]) for r in fixed)) + 2 for i, h in enumerate(head))
+    chunks: list[list[tuple[str, list[str]]]] = [[]]
+    room = used
+    for name, cells in columns:
+        w = max(len(name), *(len(c) for c in cells)) + 2
+        if chunks[-1] and room + w > width + 2:
+            chunks.append([])
+            room = used
+        chunks[-1].append((name, cells))
+        room += w
+    return [
+        table(
+            [[*f, *(c[1][i] for c in chunk)] for i, f in enumerate(fixed)],
+            [*head, *(c[0] for c in chunk)],
+            align + "r" * len(chunk),
+        )  # fmt: skip
+        for chunk in chunks
+        if chunk
+    ]
 
 
 def _simultaneous_text(traj: Trajectory) -> str:

@@ -77,4 +77,4 @@ def test_default_table_fits_100_columns_with_a_legend():
 def test_wide_table_has_every_column():
     text = B.format_bench(document(), wide=True)
     assert "rtol=1e-10 chatter=1e-10" in text and "simultaneous_impact" in text
-    assert "diverges [s]" in text and "min [s]" in text
+    assert "diverges at [s]" in text and "min [s]" in text

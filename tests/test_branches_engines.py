@@ -134,3 +134,61 @@ def test_the_plot_is_written_and_named(law_engines, tmp_path, capsys):
     assert out.stat().st_size > 0 and doc["plot"] == str(out)
     (run,) = doc["studies"][0]["runs"]
     assert run["verdict"].startswith("follows compliant")  # six contacts: its own law
+
+
+def test_the_study_text_names_every_outcome_and_contact_in_words(law_engines, capsys):
+    """One row per outcome by its name, one column per run, the contacts as v0, v1, and
+    no numbered outcome to look up; every line within 100 columns."""
+    assert main(["branches", "landing-square-edge", "--engine", "as-moreau"]) == 0
+    text = capsys.readouterr().out
+    lines = text.splitlines()
+    assert "contacts v0, v1;" in text and "(1)" not in text
+    top = next(i for i, line in enumerate(lines) if line.startswith("outcome"))
+    assert lines[top].split()[-1] == "as-moreau"
+    names = [line.rsplit(None, 1)[0].strip() for line in lines[top + 2 :] if "  " in line]
+    assert "moreau" in names and "compliant = compliant-mass" in names
+    assert "  as-moreau: follows moreau (at roundoff" in text
+    assert max(map(len, lines)) <= 100
+
+
+def test_the_suite_shows_progress_on_stderr_and_only_json_on_stdout(
+    law_engines, monkeypatch, capsys
+):
+    from harness import progress
+
+    monkeypatch.setattr(progress, "PLAIN_FIRST_S", 0.0)  # a line at every run
+    monkeypatch.setattr(progress, "PLAIN_EVERY_S", 0.0)
+    monkeypatch.setattr(progress, "bars_wanted", lambda: False)
+    argv = ["branches", "--suite", "--engine", "as-moreau", "--engine", "as-compliant", "--json"]
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    doc = json.loads(out)
+    runs = 2 * len(LANDINGS)
+    assert len(doc["studies"]) == len(LANDINGS)
+    assert f"branches: 1/{runs} runs" in err and f"branches: {runs}/{runs} runs in" in err
+    assert "now landing-hexagon: as-compliant" in err
+
+
+def test_the_laws_figure_has_one_legend_naming_every_law_drawn(law_engines, monkeypatch):
+    """Every curve of every panel is named: one legend for the figure, each law its own
+    style in every panel."""
+    from matplotlib.figure import Figure
+
+    from harness.branches.plot import LAWS_STYLE, plot_engines
+
+    saved = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: saved.append(fig))
+    laws = ["moreau", "compliant", "compliant-mass"]
+    runs = [E.EngineAtImpact("e", dt, "t_end", {law: d * (i + 1) for i, law in enumerate(laws)})
+            for dt, d in ((1e-3, 1e-2), (1e-4, 1e-3))]  # fmt: skip
+    outcomes = [E.Outcome([law], law, None, np.zeros(13)) for law in laws]
+    st = E.ImpactStudy("s", 0.0, [0, 1], 0.02, 0.02, outcomes, runs)
+    plot_engines([st, st], "unused.png")
+    (fig,) = saved
+    (legend,) = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == laws
+    for ax in fig.axes:
+        styles = {(line.get_color(), line.get_linestyle()) for line in ax.get_lines()}
+        assert len(styles) == len(ax.get_lines()) == 3
+    assert fig.axes[0].get_legend() is None
+    assert LAWS_STYLE["compliant-mass"]["color"] != LAWS_STYLE["compliant"]["color"]

@@ -145,9 +145,25 @@ def test_default_report_fits_100_columns_and_wide_has_every_column(calls):
     assert max(len(line) for line in text.splitlines()) <= 100
     wide = C.format_compare(result, wide=True)
     header = next(line for line in wide.splitlines() if line.startswith("engine"))
-    for column in ("status", "tails", "t_err[s]", "E_err", "att_err[rad]", "e_eff", "c"):
-        assert column in header.split()
+    columns = ("status", "matched  of", "ref skipped  run skipped", "t error [s]", "E error",
+               "attitude window [rad]", "e_eff  e_eff impacts", "c  c stderr")  # fmt: skip
+    for column in columns:
+        assert column in header
     assert max(len(line) for line in wide.splitlines()) > 100
+
+
+def test_wide_cells_hold_one_number_each(calls):
+    """matched and of, the skipped tails of the reference and of the run, e_eff and its
+    impacts are columns of their own: no cell of the wide table reads 'k/N' or 'n='."""
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    lines = C.format_compare(result, wide=True).splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith("engine"))
+    row = lines[header + 2]
+    assert "/" not in row and "n=" not in row
+    m = result.runs[0].metrics
+    cells = row.split()
+    assert cells[5:9] == [str(m.impacts_matched), str(m.reference_impacts),
+                          str(m.skipped_reference), str(m.skipped_run)]  # fmt: skip
 
 
 def test_report_names_who_diverges_first_when_and_why(monkeypatch):
@@ -306,3 +322,59 @@ def test_linear_model_matches_the_reference_at_tiny_inclination_through_chatter(
     assert m.impacts_matched > 100
     assert m.impact_time_error < 1e-6 * result.reference.t_final
     assert m.first_divergence_time is None
+
+
+def test_the_horizon_table_gives_the_10_and_90_percent_values_in_columns_of_their_own(
+    monkeypatch,
+):
+    """The grid model's and the perturbed model's 10 % and 90 % matched counts, each a
+    cell, in the default report and in --wide (no '15–22' range to decode)."""
+    from harness.horizon.verdict import Horizon
+
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
+        traj = stand_in(engine, dt)
+        if engine == "mujoco":  # its second impact 0.1 s late: it diverges
+            traj.impacts[1] = ImpactEvent(0.7, 1, 1.0, -0.5, 0.25)
+        return traj
+
+    monkeypatch.setattr(C, "run_simulator", fake)
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco", "linear"], dts=[1e-3])
+    mujoco, linear = result.runs
+    mujoco.horizon = Horizon(2, [1.0, 2.0, 3.0], 1e-3, 0, [4.0, 5.0, 7.0], None, 0.1, 24, 0, 1e-3)
+    linear.horizon = Horizon(2, None, 2e-3, 0, [6.0, 6.0, 8.0], None, 0.1, 24, 0, None)
+    lines = C.format_compare(result).splitlines()
+    top = next(
+        i for i, line in enumerate(lines) if line.startswith("simulator  ") and "grid" in line
+    )
+    assert lines[top] == (
+        "simulator     matched  grid 10 %  grid 90 %  within  own error  own 10 %  own 90 %"
+    )
+    assert lines[top + 2].split() == ["mujoco", "1e-03", "2", "1", "3", "yes", "1.0e-03", "4", "7"]
+    assert lines[top + 3].split() == ["linear", "2", "-", "-", "-", "2.0e-03", "6", "8"]
+    assert not any("–" in line for line in lines[top : top + 4])
+    wide = C.format_compare(result, wide=True).splitlines()
+    header = next(i for i, line in enumerate(wide) if line.startswith("engine"))
+    assert wide[header + 2].split()[-6:] == ["1", "3", "yes", "1.0e-03", "4", "7"]
+
+
+def test_a_horizon_table_too_wide_for_long_engine_names_is_split_in_two(monkeypatch):
+    """Past 100 columns the columns after `matched` go into a second table, each with the
+    simulator and its matched count."""
+    from harness.horizon.verdict import Horizon
+
+    def fake(engine, scene, dt=None, t_end=None, **_limits):
+        traj = stand_in(engine, dt)
+        if engine != "reference":  # its second impact 0.1 s late: it diverges
+            traj.impacts[1] = ImpactEvent(0.7, 1, 1.0, -0.5, 0.25)
+        return traj
+
+    monkeypatch.setattr(C, "run_simulator", fake)
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    (run,) = result.runs
+    run.engine = "an-engine-with-a-long-name"
+    run.horizon = Horizon(2, [1.0, 2.0, 3.0], 1e-3, 0, [4.0, 5.0, 7.0], None, 0.1, 24, 0, 1e-3)
+    lines = C.format_compare(result).splitlines()
+    assert max(map(len, lines)) <= 100
+    heads = [line for line in lines if line.startswith("simulator  ") and "matched" in line]
+    assert len(heads) == 3  # the verdict table and the horizon's two
+    assert "own 90 %" in heads[2] and "grid 10 %" in heads[1]

@@ -177,3 +177,29 @@ def test_a_branch_at_rest_is_left_by_the_first_real_bounce_after_it():
     bounces = _resting_after(moreau.trajectory, 1.0, [bounce])
     by_name = {c.branch: c for c in follow_branches(bounces, spread, scene, None).candidates}
     assert by_name["moreau"].until == bounce.t
+
+
+def test_the_branches_figure_names_every_branch_once_in_one_legend(flat_triangle, monkeypatch):
+    """One legend for both panels; branches whose curves are the same to roundoff are one
+    line named together (compliant = compliant-mass), every other branch its own line."""
+    from matplotlib.figure import Figure
+
+    from harness.branches.plot import plot_spread, same_curves
+
+    _, spread = flat_triangle
+    saved = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, *a, **k: saved.append(fig))
+    plot_spread(spread, "unused.png")
+    (fig,) = saved
+    (legend,) = fig.legends
+    assert all(ax.get_legend() is None for ax in fig.axes)
+    labels = [t.get_text().split(": ")[0] for t in legend.get_texts()]
+    named = [name for label in labels for name in label.split(" = ")]
+    every = ["paper", *(b.name for b in spread.branches)]
+    assert sorted(n for n in named if not n.startswith("t_u")) == sorted(every)
+    for names, first in same_curves(spread):
+        t0, e0 = first.energy_curve
+        for b in spread.branches:
+            if b.name in names[1:]:
+                t1, e1 = b.energy_curve
+                assert np.allclose(t1, t0, rtol=1e-9) and np.allclose(e1, e0, rtol=1e-9, atol=0)

@@ -237,3 +237,29 @@ def test_cli_fidelity_refuses_a_scene_not_given_in_q_p(tmp_path, capsys):
     assert main(["fidelity", str(scene), "--engine", "mujoco"]) == 2
     err = capsys.readouterr().err
     assert "q and p" in err and "Traceback" not in err
+
+
+def test_the_text_has_one_number_a_cell_and_one_row_per_scale(resolving_engine):
+    """k's fit in columns of their own (k, its standard error, the grid's least and
+    largest k, the number of dts), and the per-scale table: one row per α with each run's
+    leading impacts matched, the counts of the JSON rows."""
+    from harness.fidelity.text import format_fidelity
+
+    scene = resolve_scene("pentagon-bounce")
+    doc = fidelity(scene, [resolving_engine], [1e-2, 1e-3], eps_values(1.0, 1e-3, 4))
+    lines = format_fidelity(doc).splitlines()
+    assert max(map(len, lines)) <= 100
+    header = next(line for line in lines if line.startswith("engine"))
+    assert header.endswith("k  k stderr  k min  k max  dts")
+    fit = doc["fits"][0]
+    row = lines[lines.index(header) + 2].split()
+    lo, hi = fit["k_grid"]
+    assert row[-5:] == [f"{fit['k']:.2f}", "-", f"{lo:.2f}", f"{hi:.2f}", "2"]  # 2 dts
+    top = next(i for i, line in enumerate(lines) if line.startswith("α [rad]"))
+    assert lines[top].split()[4:] == [resolving_engine, "1e-02", resolving_engine, "1e-03"]
+    matched = {(r["dt"], r["eps"]): r["leading_matched"] for r in doc["runs"]}
+    for eps, line in zip(doc["eps"], lines[top + 2 : top + 2 + len(doc["eps"])], strict=True):
+        cells = line.split()
+        assert float(cells[1]) == pytest.approx(eps, rel=1e-2)
+        expected = [matched.get((dt, eps)) for dt in (1e-2, 1e-3)]
+        assert cells[3:] == ["-" if m is None else str(m) for m in expected]

@@ -95,5 +95,6 @@ def test_branches_names_contacts_as_the_tables_do(capsys):
     out = capsys.readouterr().out
     assert re.search(r"t_u = \S+ s, contacts v\d, v\d\n", out), out
     moreau = next(line for line in out.splitlines() if line.startswith("moreau "))
-    assert re.search(r" v\d v\d .* v\d \+\S+ s ", moreau), moreau
+    # at t_u, E after, next at (a contact), next in [s] (a number): one value a cell
+    assert re.search(r" v\d v\d +\S+ +v\d +[0-9.e+-]+ +singularity ", moreau), moreau
     assert max(len(line) for line in out.splitlines()) <= 100

@@ -180,7 +180,7 @@ def bench(
         say(
             f"bench: {setting.engine} {setting.label}: {row['status']}, "
             f"median {row['wall_time_s']:.3g} s, matched {row['impacts_matched']}/"
-            f"{row['reference_impacts']}, E_err<div {_fmt(row['energy_error_agreeing'])}"
+            f"{row['reference_impacts']}, E error following {_fmt(row['energy_error_agreeing'])}"
         )
         return row
 

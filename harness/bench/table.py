@@ -48,7 +48,11 @@ def results_table(doc: dict[str, Any], wide: bool) -> str:
     header += ["status", "time [s]"]
     header += ["min [s]"] if wide else []
     header += ["matched", "of", "follows", "t_err [s]"]
-    header += ["E_err", "E_err<div", "att<div", "diverges [s]"] if wide else ["E_err<div"]
+    header += (
+        ["E error window", "E error following", "attitude following [rad]", "diverges at [s]"]
+        if wide
+        else ["E error"]
+    )
     rows = []
     for r in doc["results"]:
         status = r["status"] if wide else SHORT_STATUS.get(r["status"], r["status"])
@@ -78,8 +82,8 @@ LEGEND = "\n".join(
         "matched; the runs that",
         "           do not follow the reference are left out of the summary below",
         "t_err      max |t - t_ref| over the matched impacts [s]",
-        "E_err<div  max |E - E_ref| / E_ref(0) up to the divergence (--wide: also E_err, over",
-        "           the common window)",
+        "E error    max |E - E_ref| / E_ref(0) up to the divergence (--wide: E error following,",
+        "           and E error window: over the common window)",
         "time       median wall time of one run [s] (--wide: and the fastest)",
         "(docs/output.md defines every column; --wide: every column, --json: every number)",
     ]
@@ -88,8 +92,8 @@ LEGEND = "\n".join(
 
 # the summary's metrics in words (the JSON keeps the keys)
 METRIC_NAMES = {
-    "energy_error_agreeing": "energy error while the run follows the reference (E_err<div)",
-    "energy_error": "energy error over the common window (E_err)",
+    "energy_error_agreeing": "energy error while the run follows the reference (E error)",
+    "energy_error": "energy error over the common window (E error window)",
     "impact_time_error": "impact time error [s] (t_err)",
 }
 

@@ -275,12 +275,21 @@ def verdict(r: EngineAtImpact, neighbour: EngineAtImpact | None) -> tuple[str, s
     return "none of the laws", f"nearest {best} ({d_best:.3g}) but not falling with dt"
 
 
+def planned_runs(engines: list[str], dts: list[float | None]) -> int:
+    """How many engine runs `study` makes for one scene (a progress bar's total)."""
+    return sum(len(_engine_dts(engine, dts)) for engine in engines)
+
+
 def study(scene, engines: list[str], dts: list[float | None], t_end: float | None = None,
-          progress=None) -> ImpactStudy:  # fmt: skip
-    """Every engine at every dt against every branch (module docstring)."""
+          progress=None, bar=None) -> ImpactStudy:  # fmt: skip
+    """Every engine at every dt against every branch (module docstring).  `bar`: a
+    harness.progress bar, advanced once per engine run (by all of them at once when the
+    scene has no undecidable state)."""
     t_end = float(t_end if t_end is not None else scene.run.t_end)
     _, t_u, y_u, contacts = undecidable_state(scene, t_end)
     if t_u is None:
+        if bar is not None:
+            bar.update(planned_runs(engines, dts))
         return ImpactStudy(scene.name, None, [], 0.0, 0.0, [], [],
                            "no undecidable state: every law gives the same run")  # fmt: skip
     unit = scene.body.radius / velocity_unit(scene)
@@ -297,10 +306,15 @@ def study(scene, engines: list[str], dts: list[float | None], t_end: float | Non
         for dt in _engine_dts(engine, dts):
             if progress:
                 progress(f"branches: {engine} dt={dt}")
+            if bar is not None:
+                now = engine if dt is None else f"{engine} dt={dt:g}"
+                bar.set_postfix_str(f"{scene.name}: {now}", refresh=False)
             if dt not in starts:
                 starts[dt] = engine_start(scene, t_u, y_u, y0, lead, after, dt, contacts)
             y_dt, outcomes_dt = starts[dt] if starts[dt][1] is not None else (y0, outcomes)
             runs.append(run_engine(engine, scene, y_dt, duration, dt, contacts, outcomes_dt))
+            if bar is not None:
+                bar.update()
     verdicts(runs)
     return ImpactStudy(scene.name, t_u, contacts, lead, after, outcomes, runs, apart=apart)
 

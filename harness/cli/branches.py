@@ -89,11 +89,12 @@ def run_spread(args) -> int:
 
 
 def run_engines(args) -> int:
-    from ..branches.engines import study
+    from ..branches.engines import planned_runs, study
     from ..branches.plot import plot_engines
     from ..branches.suite import suite
     from ..branches.text import format_study
     from ..outputs import atomic_write, check_writable
+    from ..progress import progress_bar
     from ..provenance import attach
     from ..simulators import check_engine, check_run
 
@@ -106,7 +107,9 @@ def run_engines(args) -> int:
     if args.plot:
         inputs = [] if args.suite else scene_inputs(args)
         check_writable(args.plot, args.force, inputs, what="--plot", suffixes=(".png",))
-    studies = [study(s, args.engine, dts, args.t_end, progress=log) for s in scenes]
+    total = len(scenes) * planned_runs(args.engine, dts)
+    with progress_bar(total, "branches", unit="run") as bar:
+        studies = [study(s, args.engine, dts, args.t_end, progress=log, bar=bar) for s in scenes]
     doc = attach({"command": "branches", "mode": "engines",
                   "studies": [s.to_dict() for s in studies]}, args)  # fmt: skip
     if args.plot:
@@ -114,7 +117,10 @@ def run_engines(args) -> int:
             plot_engines(studies, tmp)
         doc["plot"] = str(args.plot)
         note(f"wrote {args.plot}")
-    emit(doc, args.json, "\n\n".join(format_study(s) for s in studies))
+    text = "\n\n".join(
+        format_study(st, label=sc.contacts.label) for sc, st in zip(scenes, studies, strict=True)
+    )
+    emit(doc, args.json, text)
     return 0
 
 

@@ -12,7 +12,7 @@ from reference.scene import Scene
 from reference.trajectory import Status
 
 from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
-from ..text import impact_law_text, table
+from ..text import column_tables, impact_law_text, table
 from .branch_text import branch_lines, branch_sentence
 
 if TYPE_CHECKING:
@@ -52,46 +52,33 @@ def contact_name(scene: Scene, k: int | None) -> str:
     return scene.contacts.label(int(k))
 
 
-def impacts_cell(m) -> str:
-    """'22/59' (matched of the reference's), '35+86/302' when 86 chatter-tail bounces of
-    the reference were skipped on the way (not compared one by one)."""
-    skipped = f"+{m.skipped_reference}" if m.skipped_reference else ""
-    return f"{m.impacts_matched}{skipped}/{m.reference_impacts}"
-
-
-def _exponent_cell(fit) -> str:
-    if fit is None or fit.c is None:
-        return "-"
-    return f"{fit.c:.2f}±{fit.c_stderr:.1g}"
-
-
 def _count_range(q: list[float]) -> str:
-    """'15–22' from [10 %, 50 %, 90 %] quantiles of matched counts ('15' when equal)."""
+    """'15–22' from [10 %, 50 %, 90 %] quantiles of matched counts ('15' when equal):
+    the sentences' range (the tables give the 10 % and 90 % values in two columns)."""
     lo, hi = f"{q[0]:.0f}", f"{q[2]:.0f}"
     return lo if lo == hi else f"{lo}–{hi}"
 
 
-def horizon_cell(run: EngineRun) -> str:
-    """The table's `band`: level (a)'s 10–90 % range and whether the run's count is
-    within it ('15–22 in', '15–22 low'); event-driven runs: level (b)'s range after 'b '."""
-    h = run.horizon
-    if h is None:
-        return "-"
-    if h.matched_quantiles is not None:
-        return f"{_count_range(h.matched_quantiles)} {'in' if h.within else 'low'}"
-    if h.own_error_quantiles is not None:
-        return f"b {_count_range(h.own_error_quantiles)}"
-    return "-"
+def quantile_cells(q: list[float] | None) -> list[str]:
+    """[10 %, 90 %] of [10 %, 50 %, 90 %] quantiles of matched counts as two cells
+    ('-', '-' without them)."""
+    if q is None:
+        return ["-", "-"]
+    return [f"{q[0]:.0f}", f"{q[2]:.0f}"]
+
+
+def within_cell(within: bool | None) -> str:
+    return "-" if within is None else ("yes" if within else "no")
 
 
 def _horizon_wide(run: EngineRun) -> list[str]:
-    """band(a) with the verdict, own error, band(b): the wide table's horizon cells."""
+    """The wide table's horizon cells: the grid model's 10 % and 90 % matched, within,
+    the run's own error, the perturbed model's 10 % and 90 % matched."""
     h = run.horizon
     if h is None:
-        return ["-", "-", "-"]
-    a = "-" if h.matched_quantiles is None else horizon_cell(run)
-    b = "-" if h.own_error_quantiles is None else _count_range(h.own_error_quantiles)
-    return [a, _num(h.own_error), b]
+        return ["-"] * 6
+    return [*quantile_cells(h.matched_quantiles), within_cell(h.within), _num(h.own_error),
+            *quantile_cells(h.own_error_quantiles)]  # fmt: skip
 
 
 def horizon_sentence(run: EngineRun) -> str | None:
@@ -222,14 +209,16 @@ def _reference_counts(result: CompareResult) -> list[int]:
 
 def _verdict_table(result: CompareResult) -> str:
     """One row per run: how many of the reference's impacts it reproduces, when and why
-    it leaves them, its energy error while it follows and its wall time.  Columns that
-    are empty on every row (no chatter tail skipped, no exponent) are left out; when
-    every run is measured against the same number of reference impacts, the sentence
-    above the table gives it and the `of` column is left out too."""
+    it leaves them, its energy error while it follows, its energy exponent and its
+    standard error, and its wall time.  Columns that are empty on every row (no chatter
+    tail skipped, no exponent) are left out; when every run is measured against the same
+    number of reference impacts, the sentence above the table gives it and the `of`
+    column is left out too."""
     rows = []
     for run in result.runs:
-        m = run.metrics
+        m, fit = run.metrics, run.exponent
         t_div = m.first_divergence_time
+        has_c = fit is not None and fit.c is not None
         rows.append(
             [
                 run.label,
@@ -239,22 +228,23 @@ def _verdict_table(result: CompareResult) -> str:
                 "-" if t_div is None else f"{t_div:.5g}",
                 divergence_short(run, result.scene),
                 _num(m.energy_error_agreeing),
-                _exponent_cell(run.exponent),
+                f"{fit.c:.2f}" if has_c else "-",
+                _num(fit.c_stderr, ".1g") if has_c else "-",
                 f"{run.wall_time_s:.2g}",
             ]
         )
     header = ["simulator", "matched", "skipped", "of", "diverges at [s]",
-              "first disagreement", "E error", "c", "wall [s]"]  # fmt: skip
-    align = "lrrrrlrrr"
+              "first disagreement", "E error", "c", "c stderr", "wall [s]"]  # fmt: skip
+    align = "lrrrrlrrrr"
     drop = {2} if all(r[2] == "0" for r in rows) else set()
-    drop |= {7} if all(r[7] == "-" for r in rows) else set()
+    drop |= {7, 8} if all(r[7] == "-" for r in rows) else set()
     drop |= {3} if len(_reference_counts(result)) == 1 else set()
     # when the table is wider than WIDTH (long engine names beside an exponent): the wall
     # time left out, then the exponent, each with a note (--wide has every column)
     attempts = (
         (set(), ""),
-        ({8}, "\n(wall time left out to stay within 100 columns: --wide has it)"),
-        ({8, 7}, "\n(wall time and c left out to stay within 100 columns: --wide has them)"),
+        ({9}, "\n(wall time left out to stay within 100 columns: --wide has it)"),
+        ({9, 7, 8}, "\n(wall time and c left out to stay within 100 columns: --wide has them)"),
     )
     for extra, note in attempts:
         keep = [i for i in range(len(header)) if i not in drop | extra]
@@ -275,45 +265,37 @@ def _table_intro(result: CompareResult) -> str:
 
 
 def _horizon_table(result: CompareResult) -> list[str]:
-    """The horizon of each run as numbers: impacts the exact model matches (10–90 % of
-    its runs) with its impacts on the run's step grid, whether the run's count reaches
-    that band's 10 % value, the run's own state error and what the exact model
-    perturbed at that error matches."""
+    """The horizon of each run as numbers: the impacts the exact model matches (the 10 %
+    and 90 % quantiles of its runs) with its impacts on the run's step grid, whether the
+    run's count reaches that 10 % value, the run's own state error and what the exact
+    model perturbed at that error matches."""
     rows, runs = [], 0
     for run in result.runs:
         h = run.horizon
         if h is None:
             continue
         runs = max(runs, h.runs)
-        grid = h.matched_quantiles
-        own = h.own_error_quantiles
-        rows.append(
-            [
-                run.label,
-                str(h.matched),
-                "-" if grid is None else _count_range(grid),
-                "-" if h.within is None else ("yes" if h.within else "no"),
-                _num(h.own_error),
-                "-" if own is None else _count_range(own),
-            ]
-        )
+        rows.append([run.label, str(h.matched), *quantile_cells(h.matched_quantiles),
+                     within_cell(h.within), _num(h.own_error),
+                     *quantile_cells(h.own_error_quantiles)])  # fmt: skip
     if not rows:
         return []
-    header = ["simulator", "matched", "on step grid", "within", "own error", "at own error"]
+    header = ["simulator", "matched", "grid 10 %", "grid 90 %", "within", "own error",
+              "own 10 %", "own 90 %"]  # fmt: skip
     keep = [i for i in range(len(header)) if i < 2 or any(r[i] != "-" for r in rows)]
     intro = (
-        "Impacts the exact model itself matches (10–90 % of "
-        f"{runs} runs), with its impacts on the run's step grid and perturbed by the run's "
-        "own state error after its first matched impact:"
+        f"Impacts the exact model itself matches over {runs} runs (10 % and 90 % quantiles), "
+        "with its impacts on the run's step grid (grid) and perturbed by the run's own "
+        "state error after its first matched impact (own); within: the run matches at "
+        "least grid 10 %:"
     )
-    return [
-        *textwrap.wrap(intro, WIDTH),
-        table(
-            [[r[i] for i in keep] for r in rows],
-            [header[i] for i in keep],
-            align="".join("lrrlrr"[i] for i in keep),
-        ),
-    ]
+    rows = [[r[i] for i in keep] for r in rows]
+    header = [header[i] for i in keep]
+    text = table(rows, header, align="".join("lrrrlrrr"[i] for i in keep))
+    if max(len(line) for line in text.splitlines()) > WIDTH:  # long engine names
+        columns = [(h, [r[j] for r in rows]) for j, h in enumerate(header[2:], 2)]
+        text = "\n".join(column_tables(header[:2], [r[:2] for r in rows], columns, "lr"))
+    return [*textwrap.wrap(intro, WIDTH), text]
 
 
 def _first_to_diverge(result: CompareResult) -> list[str]:
@@ -377,7 +359,9 @@ def legend(result: CompareResult) -> str:
         parts.append("skipped: slow chatter-tail bounces of the reference passed over on the way.")
     parts.append("E error: max|E − E_ref|/E_ref(0) while the run follows the reference.")
     if any(run.exponent is not None and run.exponent.c is not None for run in result.runs):
-        parts.append("c: energy exponent ± its standard error (runs that reach the singularity).")
+        parts.append(
+            "c: energy exponent, c stderr: its standard error (runs that reach the singularity)."
+        )
     parts.append(
         "v2 = rim vertex 2, b2 = bump 2. Every column: --wide; definitions: docs/output.md."
     )
@@ -412,83 +396,79 @@ def format_compare(result: CompareResult, wide: bool = False) -> str:
     return "\n".join(lines)
 
 
+WIDE_HEADER = ["engine", "dt [s]", "status", "wall [s]", "impacts", "matched", "of",
+               "ref skipped", "run skipped", "t error [s]", "E error window",
+               "E error following", "attitude window [rad]", "attitude following [rad]",
+               "diverges at [s]", "why", "e_eff", "e_eff impacts", "c", "c stderr", "t_f from",
+               "grid 10 %", "grid 90 %", "within", "own error", "own 10 %", "own 90 %"]  # fmt: skip
+WIDE_ALIGN = "lrlrrrrrrrrrrrrlrrrrlrrlrrr"
+WIDE_NOTES = (
+    "matched: leading impacts with the reference's contact and time, |dt| <= "
+    f"{STEPS_TIME_TOLERANCE:g} steps (1e-9 s event-driven) + {RELATIVE_TIME_TOLERANCE:g}*t, "
+    "capped at half the gap to the next same-contact reference impact; of: the reference "
+    "impacts in the common window.",
+    "ref skipped, run skipped: chatter-tail impacts of the reference and of the run passed "
+    "over (approach slower than max(10 g dt, 1% of the fastest), at a contact already in "
+    "the chatter episode).",
+    "E error: max |E - E_ref|/E_ref(0) away from impacts; attitude: the largest angle "
+    "between the attitudes; window: over the common window; following: before the first "
+    "divergence (the default table's E error).",
+    "diverges at: the first impact mismatch or attitude error > 0.1 x max reference tilt. "
+    "e_eff: median -v_post/v_pre of the e_eff impacts, the run's impacts approaching "
+    "faster than max(10 g dt, 1% of the fastest).",
+    "c: energy exponent of E ~ a (t_f - t)^c and its standard error (reference.exponent), "
+    "only for runs that reach the singularity; t_f from: where t_f came from.",
+    "grid 10 %, 90 %: quantiles of the impacts matched by the exact model with its impacts "
+    "on the run's step grid; within: matched >= grid 10 %; own error: the run's state error "
+    "after its first matched impact; own 10 %, 90 %: matched by the exact model perturbed "
+    "at that error.",
+)
+
+
+def _wide_row(run: EngineRun, scene: Scene) -> list[str]:
+    m, r, fit = run.metrics, run.metrics.restitution, run.exponent
+    has_c = fit is not None and fit.c is not None
+    return [
+        run.engine,
+        "-" if run.dt is None else f"{run.dt:g}",
+        run.trajectory.status.value,
+        f"{run.wall_time_s:.2f}",
+        str(m.impacts),
+        str(m.impacts_matched),
+        str(m.reference_impacts),
+        str(m.skipped_reference),
+        str(m.skipped_run),
+        _num(m.impact_time_error, ".2e"),
+        _num(m.energy_error, ".2e"),
+        _num(m.energy_error_agreeing, ".2e"),
+        _num(m.attitude_error, ".2e"),
+        _num(m.attitude_error_agreeing, ".2e"),
+        _num(m.first_divergence_time, ".6g"),
+        divergence_short(run, scene),
+        "-" if r.median is None else f"{r.median:.4f}",
+        str(r.n),
+        f"{fit.c:.3f}" if has_c else "-",
+        _num(fit.c_stderr, ".1g") if has_c else "-",
+        (fit.t_f_source if fit is not None else None) or "-",
+        *_horizon_wide(run),
+    ]
+
+
 def format_compare_wide(result: CompareResult) -> str:
     """Every column of every run, and every rule behind them."""
-    header = [
-        "engine",
-        "dt",
-        "status",
-        "wall[s]",
-        "impacts",
-        "matched",
-        "tails",
-        "t_err[s]",
-        "E_err",
-        "E_err<div",
-        "att_err[rad]",
-        "att<div",
-        "diverge[s]",
-        "why",
-        "e_eff",
-        "c",
-        "t_f from",
-        "band(a)",
-        "own_err",
-        "band(b)",
-    ]
-    rows = []
+    rows = [_wide_row(run, result.scene) for run in result.runs]
+    lines = [*_header(result), "", table(rows, WIDE_HEADER, align=WIDE_ALIGN), ""]
+    for note in WIDE_NOTES:
+        lines += textwrap.wrap(note, WIDTH, subsequent_indent="  ")
     for run in result.runs:
         m = run.metrics
-        r = m.restitution
-        fit = run.exponent
-        rows.append(
-            [
-                run.engine,
-                "-" if run.dt is None else f"{run.dt:g}",
-                run.trajectory.status.value,
-                f"{run.wall_time_s:.2f}",
-                str(m.impacts),
-                f"{m.impacts_matched}/{m.reference_impacts}",
-                f"{m.skipped_reference}/{m.skipped_run}",
-                _num(m.impact_time_error, ".2e"),
-                _num(m.energy_error, ".2e"),
-                _num(m.energy_error_agreeing, ".2e"),
-                _num(m.attitude_error, ".2e"),
-                _num(m.attitude_error_agreeing, ".2e"),
-                _num(m.first_divergence_time, ".6g"),
-                divergence_short(run, result.scene),
-                "-" if r.median is None else f"{r.median:.4f} (n={r.n})",
-                _exponent_cell(fit),
-                fit.t_f_source or "-",
-                *_horizon_wide(run),
-            ]
-        )
-    lines = [*_header(result), "", table(rows, header, align="lrlrrrrrrrrrrlrrllrl"), ""]
-    lines += [
-        "matched: leading impacts with the reference's contact and time, |dt| <= "
-        f"{STEPS_TIME_TOLERANCE:g} steps (1e-9 s event-driven) + {RELATIVE_TIME_TOLERANCE:g}*t, "
-        "capped at half the gap to the next same-contact reference impact; of the reference "
-        "impacts in the common window",
-        "tails: chatter-tail impacts skipped (reference/run): approach slower than "
-        "max(10 g dt, 1% of the fastest), at a contact already in the chatter episode",
-        "E_err: max |E - E_ref|/E_ref(0) away from impacts; att_err: max attitude angle; "
-        "<div: the same before the first divergence",
-        "diverge: first impact mismatch or attitude error > 0.1 x max reference tilt; "
-        "e_eff: median -v_post/v_pre of the run's impacts approaching faster than "
-        "max(10 g dt, 1% of the fastest)",
-        "c: energy exponent of E ~ a (t_f - t)^c ± standard error (reference.exponent), only "
-        "for runs that reach the singularity; t_f from: where t_f came from",
-        "band(a): 10-90 % of the impacts matched by the exact model with impacts on the run's "
-        "step grid (in: count >= 10 %); own_err: the run's state error after its first matched "
-        "impact; band(b): 10-90 % matched by the exact model perturbed at that error",
-    ]
-    for run in result.runs:
-        m = run.metrics
-        if m.divergence_reason:
-            lines.append(f"  {run.label}: {m.divergence_reason}")
+        if m.first_divergence_time is not None:
+            text = f"{run.label}: {divergence_sentence(run, result.scene)}"
+            lines += textwrap.wrap(text, WIDTH, initial_indent="  ", subsequent_indent="    ")
         if run.exponent.c is None and run.exponent.reason:
             lines.append(f"  {run.label}: no c: {run.exponent.reason}")
         if run.branch is not None:
-            lines.append(f"  after t_u: {branch_sentence(run)}")
+            text = f"after t_u: {branch_sentence(run)}"
+            lines += textwrap.wrap(text, WIDTH, initial_indent="  ", subsequent_indent="    ")
     lines += _failures(result)
     return "\n".join(lines)

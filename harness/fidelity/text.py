@@ -7,10 +7,9 @@ import math
 import textwrap
 from typing import Any
 
-from ..text import table
+from ..text import column_tables, num, table
 
 WIDTH = 100
-LADDER_SPACED = 30  # up to this many scales the ladder's characters are spaced
 
 
 def alpha_star_text(star: dict[str, Any]) -> str:
@@ -26,22 +25,26 @@ def alpha_star_text(star: dict[str, Any]) -> str:
     return "-"
 
 
-def fit_text(fit: dict[str, Any]) -> str:
-    """'2.00 ± 0.05, grid 1.75..2.25 (3 dts)'; without a standard error with 2 dts; '-'
-    with fewer."""
-    if fit["k"] is None:
-        return "-"
-    text = f"{fit['k']:.2f}"
-    if fit["k_stderr"] is not None:
-        text += f" ± {fit['k_stderr']:.2f}"
-    if fit.get("k_grid"):
-        lo, hi = fit["k_grid"]
-        text += f", grid {lo:.2f}..{hi:.2f}"
-    return text + f" ({fit['n_points']} dts)"
+FIT_HEADER = ["k", "k stderr", "k min", "k max", "dts"]
+
+
+def fit_cells(fit: dict[str, Any] | None) -> list[str]:
+    """k, its standard error, the least and largest k the grid's brackets allow and the
+    number of dts fitted, one cell each ('-' where there is none)."""
+    if fit is None or fit["k"] is None:
+        return ["-"] * len(FIT_HEADER)
+    grid = fit.get("k_grid") or [None, None]
+    return [num(fit["k"], ".2f"), num(fit["k_stderr"], ".2f"), num(grid[0], ".2f"),
+            num(grid[1], ".2f"), str(fit["n_points"])]  # fmt: skip
 
 
 def dt_label(dt: float | None) -> str:
     return "event-driven" if dt is None else f"dt={dt:g}"
+
+
+def dt_header(dt: float | None) -> str:
+    """A table's column for one dt: 'event-driven', 'dt = 0.001 s'."""
+    return "event-driven" if dt is None else f"dt = {dt:g} s"
 
 
 def format_fidelity(doc: dict[str, Any]) -> str:
@@ -112,93 +115,108 @@ def lowest_pass_text(star: dict[str, Any]) -> str:
 
 
 def per_dt_rows(doc: dict[str, Any], cell, fit) -> tuple[list[float | None], list[list[str]]]:
-    """(dts, rows): per engine, `cell(star)` at each dt and `fit(engine's fit)`."""
+    """(dts, rows): per engine, `cell(star)` at each dt and the cells `fit(engine's fit)`
+    (the fit None when the engine has none)."""
     dts = sorted({s["dt"] for s in doc["alpha_star"]}, key=lambda d: -(d or math.inf))
     fits = {f["engine"]: f for f in doc["fits"]}
     rows = []
     for engine in doc["engines"]:
         by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
         cells = [cell(by_dt[d]) if d in by_dt else "" for d in dts]
-        rows.append([engine, *cells, fit(fits[engine]) if engine in fits else "-"])
+        rows.append([engine, *cells, *fit(fits.get(engine))])
     return dts, rows
 
 
 def _alpha_star_table(doc: dict[str, Any]) -> str:
-    dts, rows = per_dt_rows(doc, alpha_star_text, fit_text)
-    header = ["engine", *[dt_label(d) for d in dts], "k of α* ~ dt^k"]
-    _, low = per_dt_rows(doc, lowest_pass_text, lambda f: fit_text(f["lowest"]))
-    low_header = ["engine", *[dt_label(d) for d in dts], "k"]
+    dts, rows = per_dt_rows(doc, alpha_star_text, fit_cells)
+    header = ["engine", *[dt_header(d) for d in dts], *FIT_HEADER]
+    _, low = per_dt_rows(doc, lowest_pass_text, lambda f: fit_cells(f and f["lowest"]))
     align = "l" + "r" * (len(header) - 1)
     return (
-        "α* (smallest inclination passed with every larger one passed; '<=': passes at "
-        "every scale run,\n'>': fails at the largest); k ± its standard error, and the range "
-        "the grid's brackets allow for k\n"
+        "α* [rad] at each dt: the smallest inclination passed with every larger one passed "
+        "('<=': it\npasses at every scale run, '>': it fails at the largest); k: the exponent "
+        "of α* ~ dt^k fitted\nover dts (their number), its standard error (3 dts or more) and "
+        "the least and largest k the\ngrid's brackets allow\n"
         + table(rows, header, align)
-        + "\n\nsmallest inclination passed at all (between it and α*, passing depends on "
-        "the exact alpha)\n" + table(low, low_header, align) + _horizon_table(doc, dts, align)
+        + "\n\nthe smallest inclination [rad] passed at all (between it and α*, passing depends "
+        "on the exact α)\n" + table(low, header, align) + _horizon_table(doc, dts)
     )
 
 
-def _horizon_table(doc: dict[str, Any], dts: list[float | None], align: str) -> str:
+def _horizon_table(doc: dict[str, Any], dts: list[float | None]) -> str:
     """α* when a run fails only below the horizon band of its scale and dt."""
     if not any("horizon" in s for s in doc["alpha_star"]):
         return ""
     _, rows = per_dt_rows(
-        doc, lambda s: alpha_star_text(s["horizon"]) if "horizon" in s else "-", lambda f: ""
+        doc, lambda s: alpha_star_text(s["horizon"]) if "horizon" in s else "-", lambda f: []
     )
-    header = ["engine", *[dt_label(d) for d in dts], ""]
+    header = ["engine", *[dt_header(d) for d in dts]]
     return (
-        "\n\nα* against the horizon (a run fails only when its leading impacts matched "
+        "\n\nα* [rad] against the horizon (a run fails only when its leading impacts matched "
         "fall below\nthe 10 % value of the grid model's at that scale and dt; "
-        f"{doc.get('horizon_runs')} grid phases)\n" + table(rows, header, align)
+        f"{doc.get('horizon_runs')} grid phases)\n"
+        + table(rows, header, "l" + "r" * (len(header) - 1))
     )
 
 
-def ladder_cell(row: dict[str, Any]) -> str:
-    """Leading impacts matched, 'x' when the run fails, 's' skipped, '-' not assessed."""
-    if row["skipped"]:
-        return "s"
-    if row["passes"] is None:
+def matched_cell(row: dict[str, Any] | None) -> str:
+    """The per-scale table's cell: the leading impacts the run matched, 'skipped' (over
+    the time budget), '-' (not assessed, or not run)."""
+    if row is None or row["passes"] is None and not row["skipped"]:
         return "-"
-    return f"{row['leading_matched']}{'' if row['passes'] else 'x'}"
+    return "skipped" if row["skipped"] else str(row["leading_matched"])
 
 
-def ladder_char(row: dict[str, Any] | None) -> str:
-    """One character per scale: '+' passes, '0'..'9' fails (tenths of the leading
-    impacts matched), 's' skipped for the budget, '.' not assessed, ' ' not run."""
-    if row is None:
-        return " "
-    if row["skipped"]:
-        return "s"
-    if row["passes"] is None:
-        return "."
-    if row["passes"]:
-        return "+"
-    if row.get("within_horizon"):
-        return "h"
-    return str(min(9, int(10 * (row.get("match_fraction") or 0.0))))
+def run_label(engine: str, dt: float | None) -> str:
+    """'mujoco 1e-03', 'linear': a run's column, as `harness compare` names runs."""
+    return engine if dt is None else f"{engine} {dt:.0e}"
 
 
 def _ladder(doc: dict[str, Any]) -> str:
-    refs = doc["reference"]
+    """One row per scale (largest α first): α, ε, the reference's leading impacts and
+    each run's leading impacts matched; the runs in as many tables as WIDTH needs, then
+    a sentence per run whose verdict the count does not show (c, the horizon band)."""
     groups: dict[tuple[str, Any], dict[float, dict]] = {}
     for r in doc["runs"]:
         groups.setdefault((r["engine"], r["dt"]), {})[r["eps"]] = r
-    sep = " " if len(doc["eps"]) <= LADDER_SPACED else ""  # one character per scale
-    rows = [
-        [
-            engine,
-            "-" if dt is None else f"{dt:.0e}",
-            sep.join(ladder_char(by_eps.get(e)) for e in doc["eps"]),
-        ]
-        for (engine, dt), by_eps in groups.items()
+    refs = {r["eps"]: r for r in doc["reference"]}
+    fixed = [[f"{refs[e]['alpha']:.2g}", f"{e:.3g}", str(refs[e]["leading"])] for e in doc["eps"]]
+    head = ["α [rad]", "ε", "of"]
+    columns = [
+        (run_label(*key), [matched_cell(by_eps.get(e)) for e in doc["eps"]])
+        for key, by_eps in groups.items()
     ]
-    header = ["engine", "dt", f"α {refs[0]['alpha']:.1e} -> {refs[-1]['alpha']:.1e}"]
-    return (
-        "each scale, largest α first: + passes, 0-9 fails (tenths of the leading impacts\n"
-        "matched), h fails but within the horizon band (as good as its dt allows), s skipped\n"
-        "(budget), . not assessed\n" + table(rows, header, "lll")
-    )
+    fraction = doc["criteria"].get("match_fraction", 0.9)
+    lines = [
+        "each scale, largest α first: the leading impacts each run matches, of the reference's "
+        f"`of`\n(a run passes with at least {fraction:.0%} of them); skipped: predicted over "
+        "the time budget; -: not assessed",
+        *column_tables(head, fixed, columns, "rrr"),
+    ]
+    lines += _verdict_notes(groups)
+    return "\n".join(lines)
+
+
+def _verdict_notes(groups) -> list[str]:
+    """Runs whose verdict the matched count does not show: enough impacts but c off the
+    reference's; fails but within the horizon band."""
+    c_fails, within = [], []
+    for (engine, dt), by_eps in groups.items():
+        for r in by_eps.values():
+            alpha = f"α = {r['alpha']:.2g}"
+            if r.get("impacts_pass") and r["passes"] is False:
+                c_fails.append(f"{run_label(engine, dt)} at {alpha} ({r.get('c_check')})")
+            elif r["passes"] is False and r.get("within_horizon"):
+                within.append(f"{run_label(engine, dt)} at {alpha}")
+    notes = []
+    if c_fails:
+        notes.append("fails on c alone (enough impacts matched): " + "; ".join(c_fails))
+    if within:
+        notes.append(
+            "fails but within the horizon band (matches at least the grid model's 10 % "
+            "value at that scale and dt: as good as its dt allows): " + ", ".join(within)
+        )
+    return [textwrap.fill(n, WIDTH, subsequent_indent="  ") for n in notes]
 
 
 def _symbols(text: str) -> str:

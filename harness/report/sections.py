@@ -84,7 +84,8 @@ def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
                 e["engine"],
                 num(e["dt"], "g"),
                 e["status"],
-                f"{e['impacts_matched']}/{e['reference_impacts']}",
+                e["impacts_matched"],
+                e["reference_impacts"],
                 num(e["first_divergence_time"], ".4g"),
                 num(e["energy_error_agreeing"], ".2e"),
                 num(e["impact_time_error"], ".2e"),
@@ -100,14 +101,18 @@ def compare_section(doc: dict[str, Any], out_dir: Path) -> str:
                 "dt",
                 "status",
                 "matched",
-                "diverges at",
-                "E err",
-                "t err [s]",
+                "of",
+                "diverges at [s]",
+                "E error",
+                "t error [s]",
                 "c",
                 "wall [s]",
-                "band (a)",
+                "grid 10 %",
+                "grid 90 %",
+                "within",
                 "own error",
-                "band (b)",
+                "own 10 %",
+                "own 90 %",
             ],
             rows,
             "runs against the reference (docs/output.md defines every column)",
@@ -135,20 +140,22 @@ def _branch_paragraphs(doc: dict[str, Any]) -> list[str]:
     return [f"<h3>{head}</h3>", *[paragraph(s) for s in sentences]]
 
 
-def _band(q: list[float] | None) -> str:
-    if not q:
-        return "-"
-    return f"{q[0]:.0f}–{q[2]:.0f} (median {q[1]:.0f})"
+def _quantiles(q: list[float] | None) -> list[str]:
+    """The 10 % and 90 % quantiles of matched counts, a cell each."""
+    return ["-", "-"] if not q else [f"{q[0]:.0f}", f"{q[2]:.0f}"]
 
 
 def _horizon_cells(h: dict[str, Any] | None) -> list[Any]:
-    """band (a) with its verdict as the cell's class, own error, band (b)."""
+    """The grid model's 10 % and 90 % matched, within (its verdict as the cell's class),
+    own error, the perturbed model's 10 % and 90 % matched."""
     if not h:
-        return ["-", "-", "-"]
-    a: Any = _band(h.get("matched_quantiles"))
+        return ["-"] * 6
+    within: Any = "-"
     if h.get("within") is not None:
-        a = Cell(a, "pass" if h["within"] else "fail", "within" if h["within"] else "below")
-    return [a, num(h.get("own_error"), ".2e"), _band(h.get("own_error_quantiles"))]
+        word = "yes" if h["within"] else "no"
+        within = Cell(word, "pass" if h["within"] else "fail", "within" if h["within"] else "below")
+    return [*_quantiles(h.get("matched_quantiles")), within, num(h.get("own_error"), ".2e"),
+            *_quantiles(h.get("own_error_quantiles"))]  # fmt: skip
 
 
 def _horizon_paragraphs(doc: dict[str, Any]) -> str:
@@ -267,12 +274,14 @@ def bench_section(doc: dict[str, Any]) -> str:
 def fidelity_section(doc: dict[str, Any]) -> str:
     from ..fidelity import alpha_star_figure, matched_figure
     from ..fidelity.text import (
+        FIT_HEADER,
         alpha_star_text,
+        dt_header,
         dt_label,
-        fit_text,
+        fit_cells,
         header_lines,
-        ladder_cell,
         lowest_pass_text,
+        matched_cell,
     )
 
     parts = [paragraph(line) for line in header_lines(doc)]
@@ -289,13 +298,14 @@ def fidelity_section(doc: dict[str, Any]) -> str:
             else ""
             for d in dts
         ]
-        rows.append([engine, *cells, fit_text(fits[engine]) if engine in fits else "-"])
+        rows.append([engine, *cells, *fit_cells(fits.get(engine))])
     parts.append(
         table(
-            ["engine", *[dt_label(d) for d in dts], "k of α* ∝ dt^k (± standard error)"],
+            ["engine", *[dt_header(d) for d in dts], *FIT_HEADER],
             rows,
-            "α*: the smallest inclination the engine follows ('<=' passes at every scale run, "
-            "'>' fails at the largest)",
+            "α* [rad]: the smallest inclination the engine follows ('<=' passes at every scale "
+            "run, '>' fails at the largest); k: the exponent of α* ∝ dt^k, its standard error, "
+            "the least and largest k the grid's brackets allow, the number of dts fitted",
         )
     )
     low_rows = []
@@ -303,10 +313,10 @@ def fidelity_section(doc: dict[str, Any]) -> str:
         by_dt = {s["dt"]: s for s in doc["alpha_star"] if s["engine"] == engine}
         low = fits[engine]["lowest"] if engine in fits else None
         cells = [lowest_pass_text(by_dt[d]) if d in by_dt else "" for d in dts]
-        low_rows.append([engine, *cells, fit_text(low) if low else "-"])
+        low_rows.append([engine, *cells, *fit_cells(low)])
     parts.append(
         table(
-            ["engine", *[dt_label(d) for d in dts], "k"],
+            ["engine", *[dt_header(d) for d in dts], *FIT_HEADER],
             low_rows,
             "the smallest inclination passed at all: between it and α*, passing depends on "
             "the exact α (the transition band)",
@@ -314,7 +324,7 @@ def fidelity_section(doc: dict[str, Any]) -> str:
     )
     parts.append(_horizon_star_table(doc, dts))
     parts.append(figure(alpha_star_figure(doc), f"alpha* against dt on {doc['scene']}"))
-    parts.append(_ladder_table(doc, ladder_cell))
+    parts.append(_ladder_table(doc, matched_cell))
     parts.append(figure(matched_figure(doc), f"leading impacts matched on {doc['scene']}"))
     parts.append(_fidelity_reference_table(doc))
     parts.append(details(f"every run ({len(doc['runs'])})", _fidelity_runs_table(doc)))
@@ -331,7 +341,7 @@ def fidelity_section(doc: dict[str, Any]) -> str:
 
 def _horizon_star_table(doc: dict[str, Any], dts: list) -> str:
     """α* when a run fails only below the horizon band (fidelity --horizon-runs)."""
-    from ..fidelity.text import alpha_star_text, dt_label
+    from ..fidelity.text import alpha_star_text, dt_header
 
     if not any("horizon" in s for s in doc["alpha_star"]):
         return ""
@@ -346,7 +356,7 @@ def _horizon_star_table(doc: dict[str, Any], dts: list) -> str:
         ]
         rows.append([engine, *cells])
     return table(
-        ["engine", *[dt_label(d) for d in dts]],
+        ["engine", *[dt_header(d) for d in dts]],
         rows,
         "α* against the horizon: a run fails only when its leading impacts matched fall below "
         "the 10 % value of the grid model's at that scale and dt",
@@ -357,7 +367,7 @@ def _star_class(star: dict[str, Any]) -> str:
     return {"bracket": "pass", "at most": "pass", "above grid": "fail"}.get(star["bound"], "na")
 
 
-def _ladder_table(doc: dict[str, Any], ladder_cell) -> str:
+def _ladder_table(doc: dict[str, Any], cell) -> str:
     alphas = {r["eps"]: r["alpha"] for r in doc["reference"]}
     groups: dict[tuple, dict[float, dict]] = {}
     for r in doc["runs"]:
@@ -372,14 +382,14 @@ def _ladder_table(doc: dict[str, Any], ladder_cell) -> str:
                 continue
             cls = "skip" if r["skipped"] else ("na" if r["passes"] is None else "")
             cls = cls or ("pass" if r["passes"] else "fail")
-            cells.append(Cell(ladder_cell(r), cls, r["skipped"] or r.get("first_mismatch") or ""))
+            cells.append(Cell(cell(r), cls, r["skipped"] or r.get("first_mismatch") or ""))
         rows.append([engine, num(dt, ".0e"), *cells])
     header = ["engine", "dt", *[f"α {alphas[e]:.1e}" for e in doc["eps"]]]
     return table(
         header,
         rows,
-        f"leading impacts matched (of {doc['criteria']['leading']}) at each α: green passes, "
-        "red fails ('x'), grey skipped for the budget ('s')",
+        f"leading impacts matched (of {doc['criteria']['leading']}) at each α [rad]: green "
+        "passes, red fails, grey 'skipped' for the budget",
         left=2,
         vertical_from=2,
     )
@@ -436,7 +446,8 @@ def _fidelity_runs_table(doc: dict[str, Any]) -> str:
             num(r["eps"], ".3g"),
             num(r["alpha"], ".3g"),
             r.get("status") or "-",
-            "-" if r["passes"] is None else f"{r['leading_matched']}/{r['leading']}",
+            "-" if r["passes"] is None else r["leading_matched"],
+            r["leading"],
             num(r.get("impact_time_error_scaled"), ".2e"),
             num(r.get("energy_error"), ".2e"),
             num(r.get("c"), ".3f"),
@@ -445,7 +456,8 @@ def _fidelity_runs_table(doc: dict[str, Any]) -> str:
         ]
         for r in doc["runs"]
     ]
-    header = ["engine", "dt", "ε", "α", "status", "leading", "t err/ε", "E err", "c", "verdict"]
+    header = ["engine", "dt [s]", "ε", "α [rad]", "status", "matched", "of", "t error/ε [s]",
+              "E error", "c", "verdict"]  # fmt: skip
     return table([*header, "wall [s]"], rows, left=1)
 
 
