@@ -7,59 +7,80 @@ BIN    := $(VENV)/bin
 # sizes")
 STAMP  := $(VENV)/.installed
 STAMP_ALL := $(VENV)/.installed-all
-# the reference's compiled core, built ahead of time by the package's own build step
-# (setup.py, during `pip install -e`; skipped without a C compiler: it is then compiled just
-# in time on first use); `python -m reference.core.aot` rebuilds it when its sources
-# change and does nothing when it is fresh
+# the build's own requirements (pyproject.toml [build-system]: numba, numpy, setuptools),
+# installed first: the reference's compiled core needs nothing else to build
+BUILD_DEPS := $(VENV)/.build-deps
+# the reference's compiled core, built ahead of time by `python -m reference.core.aot`
+# (skipped without a C compiler: it is then compiled just in time on first use); it
+# rebuilds the module when its sources change and does nothing when it is fresh.  The
+# installs leave it out of pip's build (EULER_DISK_BUILD_CORE=0, setup.py) so that it
+# compiles on one core while pip installs the packages on the other (make -j2).
 AOT    := $(VENV)/.aot
 CORE   := $(wildcard reference/core/*.py)
+NO_CORE_BUILD := EULER_DISK_BUILD_CORE=0
+BUILD_REQUIRES = $(shell $(PYTHON) -c 'import shlex, tomllib; print(shlex.join(tomllib.load(open("pyproject.toml", "rb"))["build-system"]["requires"]))')
 
 .PHONY: setup demo test test-slow lint bench figures docs-figures browser clean
 
-$(STAMP): pyproject.toml
+$(BUILD_DEPS): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), sys.version' || { echo "need Python >= 3.11 (make PYTHON=/path/to/python3.11)"; exit 2; }
-	@echo "set-up 1/4: a virtual environment in $(VENV) (Python: $(PYTHON))"
+	@echo "set-up 1/3: a virtual environment in $(VENV) (Python: $(PYTHON)), pip, and what the"
+	@echo "  reference's compiled core is built with ($(BUILD_REQUIRES))"
 	$(PYTHON) -m venv $(VENV)
-	@echo "set-up 2/4: pip, then the package and its core dependencies (numpy, numba, MuJoCo,"
-	@echo "  PyBullet, rerun, ...; the package's build compiles the reference's core, about 80 s)"
 	$(BIN)/pip install --progress-bar off --upgrade pip
-	$(BIN)/pip install --progress-bar off -e .
+	$(BIN)/pip install --progress-bar off $(BUILD_REQUIRES)
+	touch $(BUILD_DEPS)
+
+# the package and its core dependencies: the demo's needs
+$(STAMP): $(BUILD_DEPS)
+	@echo "set-up 2/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
+	@echo "  beside step 3/3"
+	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e .
 	touch $(STAMP)
 
 # every extra ([all]: drake, dart, mjx, dask) and the dev tools
-$(STAMP_ALL): $(STAMP)
-	@echo "set-up 3/4: every extra (Drake, DART, MJX, dask) and the dev tools (2.5 GB in all)"
-	$(BIN)/pip install --progress-bar off -e '.[all,dev]'
-	touch $(STAMP_ALL)
+$(STAMP_ALL): $(BUILD_DEPS)
+	@echo "set-up 2/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
+	@echo "  (2.5 GB in all), beside step 3/3"
+	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e '.[all,dev]'
+	touch $(STAMP) $(STAMP_ALL)
 
-$(AOT): $(STAMP) $(CORE)
-	@echo "set-up 4/4: the reference's compiled core, rebuilt if its sources changed"
+$(AOT): $(BUILD_DEPS) $(CORE)
+	@echo "set-up 3/3: the reference's compiled core (about 100 s on one core, beside step"
+	@echo "  2/3; rebuilt when its sources change)"
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)
 
-setup: $(STAMP_ALL) $(AOT)
+# everything the tests need: the installs and the core's build side by side
+setup: $(BUILD_DEPS)
+	@$(MAKE) --no-print-directory -j2 $(STAMP_ALL) $(AOT)
+	@echo "set-up: done"
 
 # Main job: the reference against both tuned engines on the built-in chatter scene,
 # with a rerun recording of all three side by side (--force: the demo's own recording is
 # replaced when the demo runs again).
-demo: $(STAMP) $(AOT)
+demo: $(BUILD_DEPS)
+	@$(MAKE) --no-print-directory -j2 $(STAMP) $(AOT)
 	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
 		--record recordings/triangle-chatter.rrd --force
 
 # every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
 # engine whose extra is missing has its tests skipped with the reason, and under CI=true
 # (.ci/run) such a skip fails the run (tests/conftest.py)
+# The suite starts hundreds of Python processes (every worker, every CLI test): byte-code
+# caches are written even where the environment sets PYTHONDONTWRITEBYTECODE, so that each
+# process reads the project's modules (and pytest its rewritten tests) compiled once.
 TEST_WORKERS ?= auto
-test: $(STAMP_ALL) $(AOT)
-	$(BIN)/python -m pytest -n $(TEST_WORKERS)
+test: setup
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS)
 
-test-slow: $(STAMP_ALL) $(AOT)
-	$(BIN)/python -m pytest -m slow
+test-slow: setup
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -m slow
 
 lint: $(STAMP_ALL)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
 
-bench: $(STAMP_ALL) $(AOT)
+bench: setup
 	$(BIN)/python benchmarks/reference_speed.py
 
 # every figure the README and docs/api.md quote, re-measured and written between their

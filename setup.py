@@ -3,10 +3,14 @@ its stamp) is an optional extension module built by `reference.core.aot.build`, 
 `pip install .`, `pip install -e .` and `pip wheel .` carry the same module as `make
 setup`.  Without a C compiler (or without numba.pycc) the build says so in one line and
 goes on: the core is then compiled just in time on first use (docs/development.md).
-Everything else about the package is in pyproject.toml."""
+With the environment variable EULER_DISK_BUILD_CORE=0 the build leaves the core out:
+`make setup` installs the dependencies that way and builds the core with `python -m
+reference.core.aot` while pip installs the extras.  Everything else about the package
+is in pyproject.toml."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -43,6 +47,10 @@ class BuildCompiledCore(build_ext):
     """build_ext for the one module numba.pycc compiles (it runs the C compiler itself)."""
 
     def build_extension(self, ext: Extension) -> None:
+        self.built_core = None
+        if os.environ.get("EULER_DISK_BUILD_CORE") == "0":
+            print("EULER_DISK_BUILD_CORE=0: the reference's compiled core is not built here")
+            return
         if str(ROOT) not in sys.path:
             sys.path.insert(0, str(ROOT))  # the sources being built, not an installed copy
         from reference.core import aot
@@ -52,13 +60,16 @@ class BuildCompiledCore(build_ext):
 
     def copy_extensions_to_source(self) -> None:
         """An editable install (`pip install -e .`) uses the sources in place: setuptools
-        copies the module there, and the stamp goes beside it."""
+        copies the module there, and the stamp goes beside it (nothing to copy when the
+        core was not built)."""
+        built = getattr(self, "built_core", None)
+        if built is None:
+            return
         super().copy_extensions_to_source()
         from reference.compiled import STAMP_FILE
 
-        built = getattr(self, "built_core", None)
-        stamp = built.with_name(STAMP_FILE.name) if built is not None else None
-        if stamp is not None and stamp.resolve() != STAMP_FILE.resolve():
+        stamp = built.with_name(STAMP_FILE.name)
+        if stamp.resolve() != STAMP_FILE.resolve():
             shutil.copyfile(stamp, STAMP_FILE)
 
 
