@@ -356,20 +356,9 @@ def _law_name(md) -> str:
 def _law_undecided(st, md, t, cs) -> str:
     """Why the run's impact law left a simultaneous impact undecided (law_event)."""
     # here: the core's modules import numba (this runs only for such a run's message)
-    from .core.impact_laws import MAX_LAW_CONTACTS, MAX_SEQUENTIAL_IMPACTS, NOT_SETTLED, SINGULAR
-    from .core.law_event import NO_PROGRESS
+    from .core.law_message import undecided_message
 
-    law = _law_name(md)
-    outcome = int(st["law_outcome"])
-    if outcome == NOT_SETTLED:
-        return (f"the {law} law did not settle after {MAX_SEQUENTIAL_IMPACTS} single "
-                f"impacts at t = {t:.17g} (contacts {cs}): undecidable")  # fmt: skip
-    if outcome == SINGULAR:
-        return f"a contact of {cs} takes no impulse at t = {t:.17g}"
-    if outcome == NO_PROGRESS:
-        return f"the {law} law made no progress at t = {t:.17g}: stopped (undecidable)"
-    return (f"contacts touch at t = {t:.17g} beyond the {MAX_LAW_CONTACTS} the impact "
-            "laws take (undecidable)")  # fmt: skip
+    return undecided_message(_law_name(md), int(st["law_outcome"]), t, cs)
 
 
 # One-sentence messages per loop status: (state, options, model, t, the info contacts'

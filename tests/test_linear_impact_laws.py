@@ -151,6 +151,8 @@ def test_a_flat_landing_under_moreau_bounces_flat_and_rests_at_the_zeno_time(n):
     traj = simulate_linear(_scene(n, 0.5, gamma, (0, 0, h0), (0, 0, 0), "moreau"))
     assert traj.status is Status.SINGULARITY
     assert traj.impact_law == "moreau"
+    # one landing resolved by the law in the kernel's loop; its bounces in closed form
+    assert traj.stats["simultaneous_impacts"] == 1
     assert traj.t_singularity == pytest.approx(t1 + 2 * gamma * v1 / (g * (1 - gamma)),
                                                rel=1e-13)  # fmt: skip
     times = sorted({ev.t for ev in traj.impacts})
@@ -186,9 +188,11 @@ def test_the_linear_triangle_chatter_goes_on_past_its_undecidable_state(law):
 
     paper = simulate_linear("triangle-chatter")
     assert paper.status is Status.SIMULTANEOUS_IMPACT
+    assert paper.stats["simultaneous_impacts"] == 0
     traj = simulate_linear(as_scene("triangle-chatter").with_impact_law(law))
     assert traj.impact_law == law
     assert traj.status is Status.SINGULARITY
+    assert traj.stats["simultaneous_impacts"] >= 1
     # the same impacts up to the undecidable state, then more
     n = len(paper.impacts)
     assert [(e.t, e.contact) for e in traj.impacts[:n]] == [(e.t, e.contact) for e in paper.impacts]

@@ -113,6 +113,14 @@ def work_floats(law, k):
     return max(2 * k, int(size))
 
 
+def law_of_name(name, laws=LAWS):
+    """The registry entry of the law called `name` (ValueError naming the laws if none)."""
+    for law in laws:
+        if law.name == name:
+            return law
+    raise ValueError(f"impact law must be one of {', '.join(law_names(laws))}, got {name!r}")
+
+
 def with_law(law, laws=LAWS):
     """`laws` with `law` added (its name and code new)."""
     if law.name in law_names(laws) or law.code in {x.code for x in laws}:

@@ -11,8 +11,11 @@ positive root of one; roots are taken in cancellation-free form (`first_hit`).  
 - with a simultaneity window T > 0, open contacts reaching the ground
   within T of the one reached first are reached together with it: status SIMULTANEOUS
   (REASON_WINDOW) on the state where the first is reached, the others flagged in
-  `together` (their gaps, at most T|u|, not closed); an impact law resolves it
-  (laws.py);
+  `together` (their gaps, at most T|u|, not closed);
+- under an impact law (reference.core.laws) other than `paper`, a stop SIMULTANEOUS is
+  resolved by the law where it happens, inside the loop (`_law_event`: the exact core's
+  law functions on the Delassus matrix F_S Θ⁻¹ F_Sᵀ; a self-similar bounce series
+  completed in closed form), and the run goes on;
 - at every event the held set is re-solved: forces from F_B Θ⁻¹ F_Bᵀ η = g 1 over the
   subsets B of the closed contacts; the admissible one has η ≥ 0 and no closed contact
   with negative normal acceleration (an LCP by enumeration; rank(F) closed contacts is
@@ -49,8 +52,10 @@ small tuples and arrays, unpacked at their top:
 
     model   = (F, thd, tinv, w, wmax, mass, gamma, rank_f)   constants of the body
     limits  = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol, window,
-               together)   the run's limits; the simultaneity window T (0: none) and the
-              contacts it found reached together (an output, read by laws.py)
+               together, law)   the run's limits; the simultaneity window T (0: none), the
+              contacts it found reached together (those of an impact the law left
+              undecided, for the message) and the law's code
+    lawws   = (law_mats, law_vecs, law_ints, law_order)   the law's scratch
     state   = (q, p, qs, ps, acc, held, closed)   normalised state, roundoff scales of q
               and p, acceleration of the segment, held contacts, closed contacts
     scratch = (q_pre, p_pre, qn, pn, work, cidx, hidx, sidx)   work vectors, index lists
@@ -68,6 +73,11 @@ from numba import njit
 
 from ..core.clock import time_until
 from ..core.impact import bounce_ratio, chatter_impulse, impact_impulse, post_impact_velocity
+from ..core.impact_laws import MAX_SEQUENTIAL_IMPACTS, SETTLED
+from ..core.law_dispatch import solve_law
+from ..core.law_event import LAW_MAX_REPEATS, NO_PROGRESS
+from ..core.laws import LAW_PAPER
+from ..core.records import LawWork
 from ..core.tolerances import EPS  # unit roundoff of a double (one definition)
 from .model import energy as model_energy
 
@@ -103,16 +113,25 @@ REASON_FAILED_LCP = 8  # no admissible set of held contacts
 REASON_BUFFER_FULL = 9  # the event buffer is full
 REASON_FAILED_NO_ADVANCE = 10  # no further event and no end time
 REASON_WINDOW = 11  # contacts reached within the simultaneity window of each other
-N_INFO = 8  # status, n_events, n_impacts, contact_a, contact_b, reason
+REASON_LAW_UNDECIDED = 12  # the run's impact law left a simultaneous impact undecided
+# the outcome record `info`: status, n_events, n_impacts, contact_a, contact_b, reason;
+# the law's outcome (impact_laws.SETTLED …, law_event.NO_PROGRESS) and single impacts
+# when it left an impact undecided; whether a bounce series ended the run; the
+# simultaneous impacts the law resolved
+INFO_LAW_OUTCOME, INFO_LAW_HITS, INFO_SERIES, INFO_LAW_IMPACTS = 6, 7, 8, 9
+N_INFO = 10
 RB = 64  # ring buffer of recent impacts
 # integer run state `si`: scale exponents kv, kq; rows written; impacts resolved; ring
-# buffer cursor and fill; status (−1 while running) and reason code
+# buffer cursor and fill; status (−1 while running) and reason code; law impacts in a
+# row without progress (`_law_progress`)
 SI_KV, SI_KQ, SI_EVENTS, SI_IMPACTS, SI_RB_POS, SI_RB_N, SI_STATUS, SI_REASON = range(8)
-N_SI = 8
+SI_LAW_REPEATS = 8
+N_SI = 9
 # float run state `sf`: normalised gravity g̃; time t_hi + t_lo; normalised interval
-# before the impact about to be resolved
-SF_GRAVITY, SF_T_HI, SF_T_LO, SF_DT_PENDING = range(4)
-N_SF = 4
+# before the impact about to be resolved; time and true energy of the last law event
+# (`_law_progress`); the time a bounce series started (`_bounce_series`)
+SF_GRAVITY, SF_T_HI, SF_T_LO, SF_DT_PENDING, SF_LAW_T, SF_LAW_E, SF_SERIES_T = range(7)
+N_SF = 7
 
 
 @njit(cache=True)
@@ -490,21 +509,6 @@ def _impacts_now(F, q, p, qs, ps, closed, vfl):
         elif cand2 < 0:
             cand2 = c
     return ncand, cand, cand2
-
-
-@njit(cache=True)
-def law_contacts(F, q, p, qs, ps, vfl, out):
-    """The contacts of a simultaneous impact under an impact law: every
-    contact touching the ground within roundoff and not separating beyond it (normal
-    velocity f_cᵀp ≤ its roundoff level), into out; returns how many.  Held contacts
-    (resting) are in, a contact leaving is not: a law's impulse on a separating contact
-    could do positive work (docs/laws.md, "The laws")."""
-    n = 0
-    for c in range(F.shape[0]):
-        if _touching(F, c, q, qs) and _dot(F, c, p) <= _tol(F, c, ps, vfl):
-            out[n] = c
-            n += 1
-    return n
 
 
 @_helper
@@ -1026,13 +1030,442 @@ def _reached_together(F, q, p, qs, ps, acc, closed, vfl, jmin, t_window, togethe
     return other
 
 
+# ------------------------------------------------------------------ impact laws
+
+# a contact leaves a law impact when its u⁺ exceeds this many ulps of the velocity scale
+LEAVING_ULPS = 64.0
+# a bounce series is self-similar when p⁺ and the acceleration after are parallel and
+# the law maps −p⁺ to γp⁺, each to this relative residual (roundoff: ~1e-15 measured)
+SELF_SIMILAR_TOL = 1e-9
+
+
+@njit(cache=True)
+def law_contacts(F, q, p, qs, ps, vfl, together, with_together, out):
+    """The contacts of a simultaneous impact under an impact law, ascending, into out:
+    every contact touching the ground within roundoff and not separating beyond it
+    (normal velocity f_cᵀp ≤ its roundoff level; held contacts are in, a contact leaving
+    is not: a law's impulse on a separating contact could do positive work, docs/laws.md,
+    "The laws"), and with `with_together` those the simultaneity window flagged in
+    `together` (their gaps, at most T|u|, are not closed: as in the exact core).
+    Returns how many."""
+    n = 0
+    for c in range(F.shape[0]):
+        touching = _touching(F, c, q, qs) and _dot(F, c, p) <= _tol(F, c, ps, vfl)
+        if touching or (with_together and together[c]):
+            out[n] = c
+            n += 1
+    return n
+
+
+@_helper
+def _law_progress(si, sf, e_true):
+    """Whether the law may act at this stop: the time moved since the last law event,
+    or the true energy fell below half its value there (a cascade of simultaneous
+    impacts whose intervals are below the clock's resolution), or fewer than
+    LAW_MAX_REPEATS stops came without either."""
+    if sf[SF_T_HI] == sf[SF_LAW_T] and not e_true < 0.5 * sf[SF_LAW_E]:
+        si[SI_LAW_REPEATS] += 1
+    else:
+        si[SI_LAW_REPEATS] = 0
+        sf[SF_LAW_T] = sf[SF_T_HI]
+        sf[SF_LAW_E] = e_true
+    return si[SI_LAW_REPEATS] < LAW_MAX_REPEATS
+
+
+@_helper
+def _law_failed(si, info, together, contacts, k, outcome, hits):
+    """End the run undecided by the law (SIMULTANEOUS, REASON_LAW_UNDECIDED): its outcome
+    and single impacts into info, the contacts of the impact flagged in `together`."""
+    for c in range(together.shape[0]):
+        together[c] = False
+    for i in range(k):
+        together[contacts[i]] = True
+    info[INFO_LAW_OUTCOME] = outcome
+    info[INFO_LAW_HITS] = hits
+    _stop(si, info, SIMULTANEOUS, REASON_LAW_UNDECIDED, -1, -1)
+
+
+@_helper
+def _any_approaching(F, p, ps, vfl, contacts, k):
+    """Whether a contact of contacts[:k] approaches beyond roundoff."""
+    for i in range(k):
+        c = contacts[i]
+        if _dot(F, c, p) < -_tol(F, c, ps, vfl):
+            return True
+    return False
+
+
+@_helper
+def _law_impulses(model, law, p, contacts, k, gamma, lawws):
+    """(status, single impacts) of the run's law on contacts[:k] (the exact core's law
+    functions through its dispatch, law_dispatch.solve_law): Delassus matrix
+    W = F_S Θ⁻¹ F_Sᵀ (w_ab = f_aᵀΘ⁻¹f_b, the change of contact a's normal velocity per
+    unit impulse at b, from Θ Δp = Σ f_b λ_b: the paper, section 2.5, eqs. Theta and
+    impactequ) and u⁻ = F_S p into the scratch; Λ and u⁺ = u⁻ + WΛ out.  With one
+    contact this is `_apply_impulse`'s impact, bit for bit (eq. F)."""
+    F, w = model[0], model[3]
+    mats, vecs, ints, order = lawws
+    nc = F.shape[0]
+    W, chol = mats[:nc], mats[nc:]
+    u_pre, lam, u_post, vec = vecs[:nc], vecs[nc : 2 * nc], vecs[2 * nc : 3 * nc], vecs[3 * nc :]
+    active = ints[nc : 2 * nc]
+    for a in range(k):
+        u_pre[a] = _dot(F, contacts[a], p)
+        lam[a] = 0.0
+        u_post[a] = 0.0
+        active[a] = 0
+        for b in range(k):
+            W[a, b] = w[contacts[a], contacts[b]]
+            chol[a, b] = 0.0
+    for i in range(vec.shape[0]):
+        vec[i] = 0.0
+    work = LawWork(chol, vec, active, order, 0, MAX_SEQUENTIAL_IMPACTS)
+    return solve_law(law, W, u_pre, gamma, k, lam, u_post, work)
+
+
+@_helper
+def _add_law_impulses(F, tinv, contacts, k, lam, p):
+    """p ← p + Θ⁻¹F_SᵀΛ, contact by contact (as `_apply_impulse`)."""
+    for i in range(k):
+        if lam[i] != 0.0:
+            c = contacts[i]
+            for j in range(3):
+                p[j] += tinv[j] * F[c, j] * lam[i]
+
+
+@_helper
+def _law_completes(u_post, k, gamma, below):
+    """Whether, with 0 < γ < 1, some contact leaves the impact (u⁺ above LEAVING_ULPS
+    ulps of `below`) and every one that does leaves at u⁺ ≤ `below`: the bounces that
+    would follow are too small to follow and the impact is taken plastic."""
+    if not (0.0 < gamma < 1.0 and below > 0.0):
+        return False
+    noise = LEAVING_ULPS * EPS * below
+    leaving = False
+    for i in range(k):
+        if u_post[i] > noise:
+            if u_post[i] > below:
+                return False
+            leaving = True
+    return leaving
+
+
+@_helper
+def _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q, p_pre, p):
+    """One IMPACT row per contact that took an impulse, at the impact's time (the first
+    carries the interval before it, the others 0)."""
+    nc = contacts.shape[0]
+    vecs = lawws[1]
+    u_pre, lam, u_post = vecs[:nc], vecs[nc : 2 * nc], vecs[2 * nc : 3 * nc]
+    dtn = sf[SF_DT_PENDING]
+    for i in range(k):
+        if lam[i] > 0.0:
+            _write_row(out, si[SI_EVENTS], IMPACT, contacts[i], -1, si[SI_KV], si[SI_KQ],
+                       held, dtn, sf[SF_T_HI], sf[SF_T_LO], lam[i], u_pre[i], u_post[i], E,
+                       E_post, q, p_pre, q, p, acc)  # fmt: skip
+            si[SI_EVENTS] += 1
+            si[SI_IMPACTS] += 1
+            dtn = 0.0
+    sf[SF_DT_PENDING] = 0.0
+
+
+@_helper
+def _rest_acceleration(F, tinv, g, rest, m, acc):
+    """The constant acceleration with the m ≤ 2 contacts rest[:m] held (F_B Θ⁻¹ F_Bᵀ η
+    = g 1, ṗ = Θ⁻¹F_Bᵀη − g u3: the paper, section 2.5, eq. pacccontact) into acc;
+    False when a force η comes out negative (or the set is singular)."""
+    for i in range(3):
+        acc[i] = 0.0
+    if m == 1:
+        i0 = rest[0]
+        e = g / _w(F, tinv, i0, i0)
+        if e < 0.0:
+            return False
+        for i in range(3):
+            acc[i] = tinv[i] * F[i0, i] * e
+    elif m == 2:
+        i0, i1 = rest[0], rest[1]
+        a00, a01, a11 = _w(F, tinv, i0, i0), _w(F, tinv, i0, i1), _w(F, tinv, i1, i1)
+        det = a00 * a11 - a01 * a01
+        if det == 0.0:
+            return False
+        e0 = g * (a11 - a01) / det
+        e1 = g * (a00 - a01) / det
+        if e0 < 0.0 or e1 < 0.0:
+            return False
+        for i in range(3):
+            acc[i] = tinv[i] * (F[i0, i] * e0 + F[i1, i] * e1)
+    acc[2] -= g
+    return True
+
+
+@_helper
+def _theta_dot(thd, x, y):
+    """xᵀΘy."""
+    return x[0] * (thd[0] * y[0]) + x[1] * (thd[1] * y[1]) + x[2] * (thd[2] * y[2])
+
+
+@_helper
+def _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, a):
+    """κ of the self-similar bounce series a law impact at q = 0 (every contact touching)
+    that left p⁺ = p may start (`_bounce_series`), with the contacts left resting (|u⁺|
+    within LEAVING_ULPS ulps of vfl) into rest and their held acceleration into a; 0
+    when it starts none: a contact leaves, fewer than rank(F) rest, their forces are
+    ≥ 0, and a = −κp⁺ with κ > 0 (to SELF_SIMILAR_TOL, in the Θ norm)."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    noise = LEAVING_ULPS * EPS * vfl
+    m = 0
+    leaving = False
+    for i in range(k):
+        if abs(u_post[i]) <= noise:
+            if m < 3:
+                rest[m] = contacts[i]
+            m += 1
+        elif u_post[i] > noise:
+            leaving = True
+    if m >= rank_f or not leaving or not _rest_acceleration(F, tinv, gt, rest, m, a):
+        return 0.0, m
+    norm2 = _theta_dot(thd, p, p)
+    kappa = -_theta_dot(thd, a, p) / norm2
+    r2 = 0.0
+    for i in range(3):
+        r = a[i] + kappa * p[i]
+        r2 += r * (thd[i] * r)
+    if not kappa > 0.0 or r2 > SELF_SIMILAR_TOL**2 * kappa**2 * norm2:
+        return 0.0, m
+    return kappa, m
+
+
+@_helper
+def _series_maps_back(model, law, p, contacts, k, lawws, pn, miss):
+    """Whether the law maps −p⁺ (p⁺ = p) to γp⁺ (to SELF_SIMILAR_TOL, in the Θ norm):
+    every bounce of the series is then the first × γ^(j−1).  Leaves the law's impulses,
+    u⁻ and u⁺ of the landing at −p⁺ in the scratch (those of the series' first bounce)."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    for i in range(3):
+        pn[i] = -p[i]
+    status, _ = _law_impulses(model, law, pn, contacts, k, gamma, lawws)
+    if status != SETTLED:
+        return False
+    nc = F.shape[0]
+    _add_law_impulses(F, tinv, contacts, k, lawws[1][nc : 2 * nc], pn)
+    for i in range(3):
+        miss[i] = pn[i] - gamma * p[i]
+    return _theta_dot(thd, miss, miss) <= SELF_SIMILAR_TOL**2 * _theta_dot(thd, p, p)
+
+
+@_helper
+def _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts, k, flight, m):
+    """The bounces of a self-similar series after the law impact at the current time, p⁺
+    = p (`_bounce_series`): bounce j at t + flight (1 − γʲ)/(1 − γ), one IMPACT row per
+    contact that takes an impulse, impulses and velocities those of the first × γ^(j−1),
+    while the energy before a bounce is above the floor and within the impact budget;
+    the held set of the rows: the m contacts left resting (lawws' rest).  Returns the
+    time of the last row."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    max_impacts, log2_floor = limits[1], limits[2]
+    q, p, qs, ps, acc, held, closed = state
+    zero, pp, a, pq = scratch[0], scratch[1], scratch[2], scratch[4]
+    nc = F.shape[0]
+    vecs, rest = lawws[1], lawws[2][2 * nc :]
+    lam = vecs[nc : 2 * nc]
+    kv, kq, gt = si[SI_KV], si[SI_KQ], sf[SF_GRAVITY]
+    t0_hi, t0_lo = sf[SF_T_HI], sf[SF_T_LO]
+    last_hi, last_lo = t0_hi, t0_lo
+    for i in range(3):
+        zero[i] = 0.0
+    took = 0
+    for i in range(k):
+        if lam[i] > 0.0:
+            took += 1
+    budget = min(max_impacts - si[SI_IMPACTS], out[0].shape[0] - 2 - si[SI_EVENTS])
+    n, j = 0, 1
+    while took > 0 and n + took <= budget:
+        r = gamma ** (j - 1)
+        for i in range(3):
+            pp[i] = -r * p[i]
+            pq[i] = gamma * r * p[i]
+        e_pre = _energy(zero, pp, thd, mass, gt)
+        if not (e_pre > 0.0 and math.log2(e_pre) + 2 * kv > log2_floor and flight * r > 0.0):
+            break
+        if j == 1:  # the bounces' held set: the contacts left resting
+            for i in range(3):
+                held[i] = rest[i] if i < m else -1
+        e_post = _energy(zero, pq, thd, mass, gt)
+        since = flight * (1.0 - gamma**j) / (1.0 - gamma)
+        last_hi, last_lo = _add_time(t0_hi, t0_lo, math.ldexp(since, kq - kv))
+        dtn = flight * r
+        for i in range(k):
+            if lam[i] > 0.0:
+                _write_row(out, si[SI_EVENTS], IMPACT, contacts[i], -1, kv, kq, held, dtn,
+                           last_hi, last_lo, lam[i] * r, vecs[i] * r, vecs[2 * nc + i] * r,
+                           e_pre, e_post, zero, pp, zero, pq, a)  # fmt: skip
+                si[SI_EVENTS] += 1
+                si[SI_IMPACTS] += 1
+                dtn = 0.0
+        n += took
+        j += 1
+    return last_hi, last_lo
+
+
+@_helper
+def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, vfl):
+    """After a law impact at q = 0 with every contact touching (p⁺ = p): the Zeno series
+    of self-similar bounces, completed in closed form when there is one (docs/laws.md,
+    "Self-similar bounce series").  With B the contacts resting after the impact held,
+    the acceleration a is constant; if a = −κp⁺ (κ > 0) every gap is f_cᵀp⁺ ≥ 0 times one
+    bouncing-ball profile and the body is back at q = 0 with p = −p⁺ after 2/κ; if the
+    law maps −p⁺ to γp⁺, every later flight is γ times the one before.  Writes the
+    bounces (`_series_rows`), then ends the run at rest (SINGULARITY, REASON_SINGULARITY,
+    info[INFO_SERIES]) at t + 2/(κ(1 − γ)), if before t_end.  Returns whether it did."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    q, p, qs, ps, acc, held, closed = state
+    gt = sf[SF_GRAVITY]
+    nc = F.shape[0]
+    if not (0.0 < gamma < 1.0 and gt > 0.0) or k < nc:
+        return False
+    rest, u_post = lawws[2][2 * nc :], lawws[1][2 * nc : 3 * nc]
+    kappa, m = _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, scratch[2])
+    if kappa == 0.0:
+        return False
+    if not _series_maps_back(model, limits[7], p, contacts, k, lawws, scratch[3], scratch[4]):
+        return False
+    flight = 2.0 / kappa
+    duration = flight / (1.0 - gamma)
+    kv, kq = si[SI_KV], si[SI_KQ]
+    if not sf[SF_T_HI] + math.ldexp(duration, kq - kv) <= limits[0]:
+        return False
+    last_hi, last_lo = _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts,
+                                    k, flight, m)  # fmt: skip
+    # at rest at t + 2/(κ(1 − γ)): the coordinates the contacts see are 0 (the rod's roll
+    # about its axis, which they do not see, carried on for the tail)
+    for i in range(3):
+        q[i] = q[i] + p[i] * duration
+    _project(q, F, tinv, contacts, min(k, 3))
+    _project(p, F, tinv, contacts, min(k, 3))
+    t_hi, t_lo = _add_time(sf[SF_T_HI], sf[SF_T_LO], math.ldexp(duration, kq - kv))
+    sf[SF_DT_PENDING] = math.ldexp((t_hi - last_hi) + (t_lo - last_lo), kv - kq)
+    sf[SF_SERIES_T] = sf[SF_T_HI]
+    sf[SF_T_HI], sf[SF_T_LO] = t_hi, t_lo
+    info[INFO_SERIES] = 1
+    _stop(si, info, SINGULARITY, REASON_SINGULARITY, -1, -1)
+    return True
+
+
+@_helper
+def _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, E, vfl):
+    """The impact of contacts[:k] under the run's law (`_law_event`): Λ, p⁺ = p⁻ +
+    Θ⁻¹F_SᵀΛ, one IMPACT row per contact that took an impulse; bounces too small to
+    follow (every contact that leaves, below decouple_tol × the velocity scale) taken
+    plastic (γ = 0); then the energy floor and a self-similar bounce series.  Returns
+    False when it ended the run."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    q, p, qs, ps, acc, held, closed = state
+    law, together, decouple_tol, log2_floor = limits[7], limits[6], limits[4], limits[2]
+    nc = F.shape[0]
+    status, hits = _law_impulses(model, law, p, contacts, k, gamma, lawws)
+    vecs = lawws[1]
+    if status == SETTLED and _law_completes(vecs[2 * nc : 3 * nc], k, gamma, decouple_tol * vfl):
+        status, hits = _law_impulses(model, law, p, contacts, k, 0.0, lawws)
+    if status != SETTLED:
+        _law_failed(si, info, together, contacts, k, status, hits)
+        return False
+    if si[SI_EVENTS] + k + 3 >= out[0].shape[0]:
+        _stop(si, info, MAX_IMPACTS, REASON_NONE, -1, -1)
+        return False
+    q_pre, p_pre = scratch[0], scratch[1]
+    for i in range(3):
+        q_pre[i] = q[i]
+        p_pre[i] = p[i]
+    _add_law_impulses(F, tinv, contacts, k, vecs[nc : 2 * nc], p)
+    E_post = _energy(q, p, thd, mass, sf[SF_GRAVITY])
+    _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q_pre, p_pre, p)
+    info[INFO_LAW_IMPACTS] += 1
+    if not (E_post > 0.0):
+        _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
+        return False
+    if math.log2(E_post) + 2 * si[SI_KV] <= log2_floor:
+        _stop(si, info, SINGULARITY, REASON_ENERGY_EXHAUSTED, -1, -1)
+        return False
+    return not _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws,
+                              contacts, k, vfl)  # fmt: skip
+
+
+@_helper
+def _go_on(model, state, out, si, sf, info):
+    """Go on after a law event as from a start (`_start`) at the state (q, p): the
+    scales renormalised, the contacts resting there closed, the held set (none until
+    the next flight step settles it, recorded on the last row) and the recent impacts
+    forgotten (a chatter's history ends at a multi-contact impact)."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    q, p, qs, ps, acc, held, closed = state
+    E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
+    if not (E > 0.0):
+        _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
+        return
+    _renormalise(F, q, p, qs, ps, E, si, sf, 1)
+    for i in range(3):
+        qs[i] = abs(q[i])
+        ps[i] = abs(p[i])
+        acc[i] = 0.0
+        held[i] = -1
+    acc[2] = -sf[SF_GRAVITY]
+    _record_held_set(out, si[SI_EVENTS] - 1, held, acc)
+    for c in range(F.shape[0]):
+        closed[c] = False
+    si[SI_RB_POS] = 0
+    si[SI_RB_N] = 0
+    sf[SF_DT_PENDING] = 0.0
+    E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
+    _close_resting_contacts(F, q, p, qs, ps, closed, _velocity_scale(E, wmax))
+
+
+@njit(cache=True)
+def _law_event(model, limits, state, scratch, out, si, sf, info, lawws):
+    """A stop SIMULTANEOUS under the paper's rule (two contacts reached at once, an impact
+    that would push a held contact, a contact at the ground when a chatter accumulates,
+    contacts reached within the simultaneity window), resolved by the run's impact law
+    (limits[7], a code of reference.core.laws) on the state before the impact, inside
+    the loop:
+
+    1. the contacts of the impact (`law_contacts`): every contact touching and not
+       separating, and those the window flagged;
+    2. when one of them approaches, their impact under the law (`_law_impact`: the
+       exact core's law functions on the linear Delassus matrix F_S Θ⁻¹ F_Sᵀ), with a
+       self-similar bounce series completed in closed form (`_bounce_series`);
+    3. the run goes on from the state after it as from a start (`_go_on`: its contacts
+       left at zero normal velocity closed, the held-contact phases).
+
+    A law that does not settle (or a contact no impulse moves), or LAW_MAX_REPEATS stops
+    without the time or the energy moving, end the run REASON_LAW_UNDECIDED."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    q, p, qs, ps, acc, held, closed = state
+    nc = F.shape[0]
+    with_together = si[SI_REASON] == REASON_WINDOW
+    si[SI_STATUS] = -1
+    si[SI_REASON] = REASON_NONE
+    E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
+    vfl = _velocity_scale(max(E, 0.0), wmax)
+    contacts = lawws[2][:nc]
+    k = law_contacts(F, q, p, qs, ps, vfl, limits[6], with_together, contacts)
+    if not _law_progress(si, sf, math.ldexp(E, 2 * si[SI_KV])):
+        _law_failed(si, info, limits[6], contacts, k, NO_PROGRESS, 0)
+        return
+    if _any_approaching(F, p, ps, vfl, contacts, k):
+        if not _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contacts,
+                           k, E, vfl):  # fmt: skip
+            return
+    _go_on(model, state, out, si, sf, info)
+
+
 # ------------------------------------------------------------------ the event loop
 
 
 @_helper
-def _step(model, limits, state, scratch, ring, out, si, sf, info):
+def _step(model, limits, state, scratch, ring, out, si, sf, info, lawws):
     """One pass of the event loop: two contacts hitting at once (undecidable, the paper,
-    section 2.3), one (`_impact_step`) or none (`_flight_step`)."""
+    section 2.3), one (`_impact_step`) or none (`_flight_step`); where the paper's rule
+    stops undecided, the run's impact law resolves the impact (`_law_event`)."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
     q, p, qs, ps, acc, held, closed = state
     E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
@@ -1044,6 +1477,8 @@ def _step(model, limits, state, scratch, ring, out, si, sf, info):
         _impact_step(model, limits, state, scratch, ring, out, si, sf, info, cand, E, vfl)
     else:
         _flight_step(model, limits, state, scratch, out, si, sf, info, vfl)
+    if si[SI_STATUS] == SIMULTANEOUS and limits[7] != LAW_PAPER:
+        _law_event(model, limits, state, scratch, out, si, sf, info, lawws)
 
 
 @_helper
@@ -1097,6 +1532,20 @@ def new_loop_state(n_contacts: int):
     )
 
 
+def new_law_scratch(n_contacts: int, vec_floats: int):
+    """The scratch of the run's impact law (`_law_impulses`): W and its factor (2n × n),
+    u⁻, Λ, u⁺ and `vec_floats` floats of the law's own (reference.core.laws.work_floats),
+    the contacts of the impact, the law's active set and the resting contacts of a
+    bounce series (2n + 3 integers), and an empty order (the law's own)."""
+    n = n_contacts
+    return (
+        np.zeros((2 * n, n)),
+        np.zeros(3 * n + vec_floats),
+        np.zeros(2 * n + 3, dtype=np.int64),
+        np.zeros(0, dtype=np.int64),
+    )
+
+
 @njit(cache=True)
 def start_kernel(
     F, thd, tinv, w, wmax, mass, g, gamma, rank_f, q_init, p_init, record_states,
@@ -1120,6 +1569,8 @@ def start_kernel(
     si[SI_STATUS] = -1
     sf[:] = 0.0
     sf[SF_GRAVITY] = g
+    sf[SF_LAW_T] = math.nan  # no law event yet
+    sf[SF_LAW_E] = math.inf
     info[:] = 0
     E = _energy(q, p, thd, mass, g)
     if not (E > 0.0):
@@ -1135,15 +1586,20 @@ def start_kernel(
 @njit(cache=True)
 def continue_kernel(
     F, thd, tinv, w, wmax, mass, gamma, rank_f, t_end, max_impacts, log2_energy_floor,
-    chatter_tol, decouple_tol, window, record_states, out_i, out_f, out_s, info,
-    q, p, qs, ps, acc, held, closed, si, sf, rb_c, rb_ldt, rb_lu, together, budget,
+    chatter_tol, decouple_tol, window, law, record_states, out_i, out_f, out_s, info,
+    q, p, qs, ps, acc, held, closed, si, sf, rb_c, rb_ldt, rb_lu, together,
+    law_mats, law_vecs, law_ints, law_order, budget,
 ):  # fmt: skip
     """At most `budget` passes of the event loop (`_step`), so that the caller regains
     control (Ctrl-C) between calls.  Returns the number of events once a status is set
-    (after `_finish`: END row, outcome record), else -1: call again."""
+    (after `_finish`: END row, outcome record), else -1: call again.  `law`: the code
+    of the run's impact law (reference.core.laws); law_*: its scratch
+    (`new_law_scratch`)."""
     nc = F.shape[0]
     model = (F, thd, tinv, w, wmax, mass, gamma, rank_f)
-    limits = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol, window, together)
+    limits = (t_end, max_impacts, log2_energy_floor, chatter_tol, decouple_tol, window, together,
+              law)  # fmt: skip
+    lawws = (law_mats, law_vecs, law_ints, law_order)
     out = (out_i, out_f, out_s, record_states)
     state = (q, p, qs, ps, acc, held, closed)
     cidx = np.zeros(nc + 3, dtype=np.int64)
@@ -1153,7 +1609,7 @@ def continue_kernel(
     ring = (rb_c, rb_ldt, rb_lu)
     steps = 0
     while si[SI_STATUS] < 0 and steps < budget:
-        _step(model, limits, state, scratch, ring, out, si, sf, info)
+        _step(model, limits, state, scratch, ring, out, si, sf, info, lawws)
         steps += 1
     if si[SI_STATUS] < 0:
         return -1

@@ -1,6 +1,6 @@
-"""One run of the linear model's compiled kernel under the paper's rule (`run_segment`),
-its rows as a `LinearRun`, and its one-line message: what `simulate.run_linear` returns
-and what `laws.run_under_law` joins, segment by segment, past undecidable states."""
+"""One run of the linear model's compiled kernel (`run_segment`), its rows as a
+`LinearRun`, and its one-line message: what `simulate.run_linear` returns.  The run's
+impact law resolves a simultaneous impact inside the kernel's loop (kernel._law_event)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.law_message import undecided_message
+from ..core.laws import law_of_name, work_floats
 from ..trajectory import Status
 from . import kernel as K
 from .model import LinearModel
@@ -63,8 +65,9 @@ class LinearRun:
     p_post: np.ndarray | None
     acc: np.ndarray | None
     wall_time_s: float
-    impact_law: str = "paper"  # the law of simultaneous impacts applied (laws.py)
+    impact_law: str = "paper"  # the law of simultaneous impacts (reference.core.laws)
     simultaneity_window: float = 0.0  # contacts reached within it count as one impact
+    simultaneous_impacts: int = 0  # the simultaneous impacts the law resolved in the loop
 
     @property
     def impact_rows(self) -> np.ndarray:
@@ -89,6 +92,7 @@ _REASONS = {
     K.REASON_BUFFER_FULL: "event buffer full",
     K.REASON_FAILED_NO_ADVANCE: "no further event and no end time",
     K.REASON_WINDOW: "contacts reached within the simultaneity window of each other",
+    K.REASON_LAW_UNDECIDED: "the impact law left a simultaneous impact undecided",
 }
 
 
@@ -121,10 +125,11 @@ def run_segment(
     decouple_tol: float,
     record_states: bool,
     window: float = 0.0,
+    impact_law: str = "paper",
 ) -> tuple[LinearRun, tuple]:
-    """`run_linear` under the paper's rule, with the kernel's loop state at the stop
-    (kernel.new_loop_state: the normalised q, p, their roundoff scales, ..., si, sf):
-    where a law continues the run (laws.py)."""
+    """`run_linear`: the kernel's run from (q0, p0) under `impact_law` (a name of the
+    law registry, reference.core.laws), with its loop state at the stop
+    (kernel.new_loop_state: the normalised q, p, their roundoff scales, ..., si, sf)."""
     q0 = np.array(q0, dtype=float)
     p0 = np.array(p0, dtype=float)
     F = model.F
@@ -141,6 +146,8 @@ def run_segment(
     w, wmax = K._contact_products(F, tinv)
     consts = (F, model.theta, tinv, w, wmax, model.mass)
     loop = K.new_loop_state(F.shape[0])
+    law = law_of_name(impact_law)
+    law_scratch = K.new_law_scratch(F.shape[0], work_floats(law, F.shape[0]))
     t0 = time.perf_counter()
     done = K.start_kernel(
         *consts, model.gravity, model.restitution, model.rank, q0, p0, bool(record_states),
@@ -150,8 +157,8 @@ def run_segment(
         n = K.continue_kernel(
             *consts, model.restitution, model.rank, float(t_end), int(max_impacts),
             float(log2_floor), float(chatter_tol), float(decouple_tol), float(window),
-            bool(record_states),
-            out_i, out_f, out_s, info, *loop, LOOP_BUDGET,
+            int(law.code), bool(record_states),
+            out_i, out_f, out_s, info, *loop, *law_scratch, LOOP_BUDGET,
         )  # fmt: skip
         done = n >= 0
     n = int(loop[7][K.SI_EVENTS])
@@ -170,6 +177,8 @@ def run_segment(
             p_post=np.ldexp(S[:, 9:12], ev),
             acc=_segment_accelerations(model, oi[:, [K.I_HELD1, K.I_HELD2]]),
         )
+        if info[K.INFO_SERIES]:  # at rest on every contact at the series' end
+            states["acc"][-1] = 0.0
     else:
         states = dict(q_pre=None, p_pre=None, q_post=None, p_post=None, acc=None)
     dtn = of[:, K.F_DTN]
@@ -177,6 +186,14 @@ def run_segment(
         log2_dt = np.where(dtn > 0, np.log2(np.where(dtn > 0, dtn, 1.0)), -np.inf) + oi[:, K.I_DTE]
     t_stop = of[n - 1, K.F_THI] + of[n - 1, K.F_TLO] if n else 0.0
     msg = run_message(status, reason, t_stop, int(info[2]), (int(info[3]), int(info[4])))
+    if reason == K.REASON_LAW_UNDECIDED:
+        contacts = [int(c) for c in np.flatnonzero(loop[12])]
+        msg = undecided_message(impact_law, int(info[K.INFO_LAW_OUTCOME]), t_stop, contacts,
+                                int(info[K.INFO_LAW_HITS]))  # fmt: skip
+    elif info[K.INFO_SERIES]:
+        msg = (f"self-similar bounces from t = {float(loop[8][K.SF_SERIES_T]):.17g} completed "
+               "in closed form (t_f = t + 2/(kappa (1 - gamma))): at rest on all contacts at "
+               f"t = {t_stop:.17g}")  # fmt: skip
     run = LinearRun(
         model=model,
         status=status,
@@ -198,7 +215,9 @@ def run_segment(
         energy_post=np.ldexp(of[:, K.F_EPOST], 2 * kv),
         log2_energy=of[:, K.F_LOG2E].copy(),
         wall_time_s=wall,
+        impact_law=impact_law,
         simultaneity_window=float(window),
+        simultaneous_impacts=int(info[K.INFO_LAW_IMPACTS]),
         **states,
     )
     return run, loop

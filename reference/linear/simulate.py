@@ -18,7 +18,6 @@ import numpy as np
 from ..trajectory import ImpactEvent, Phase, Status, Trajectory
 from . import kernel as K
 from .domain import cut_at_exit, first_exit
-from .laws import run_under_law
 from .model import LinearModel, full_states, linear_state
 from .segment import LinearRun, run_segment
 
@@ -49,21 +48,15 @@ def run_linear(
     for completing without the proof and for two-contact accumulations (kernel.py).
 
     `impact_law`: `paper` (an undecidable impact ends the run `simultaneous_impact`),
-    or `moreau` / `sequential` / `compliant`: the run goes on past it under that law
-    (laws.py).
+    or a law of the registry (reference.core.laws: `moreau`, `sequential`, `compliant`,
+    ...): the kernel's loop resolves the impact under that law and goes on
+    (kernel._law_event; the run's `simultaneous_impacts` counts them).
     `simultaneity_window`: open contacts reaching the ground within this time of the
     first are reached together with it (0: strictly sequential)."""
-    if impact_law != "paper":
-        return run_under_law(
-            model, q0, p0, impact_law, t_end=t_end, max_impacts=max_impacts,
-            energy_floor=energy_floor, chatter_tol=chatter_tol, decouple_tol=decouple_tol,
-            record_states=record_states, window=simultaneity_window,
-        )  # fmt: skip
-    run = run_segment(
+    return run_segment(
         model, q0, p0, t_end, max_impacts, energy_floor, chatter_tol, decouple_tol,
-        record_states, simultaneity_window,
+        record_states, simultaneity_window, impact_law,
     )[0]  # fmt: skip
-    return run
 
 
 # ----------------------------------------------------------------------------- scene
@@ -111,7 +104,7 @@ def simulate_linear(
     from the last energy decades, see exponent.extrapolate_time_to_go), t_end,
     max_impacts. Chatter sequences are completed in closed form (kernel.py); they are
     listed in stats["accumulations"], not as impacts.  The scene's `impact_law` and
-    `simultaneity_window` apply (laws.py; docs/laws.md, "The linear model under the
+    `simultaneity_window` apply (kernel._law_event; docs/laws.md, "The linear model under the
     laws")."""
     from ..checks import check_linear_options, run_horizon
     from ..scenes import as_scene
@@ -224,6 +217,7 @@ def trajectory_from_run(
         "wall_time_s": run.wall_time_s,
         "n_events": int(len(run.kind)),
         "accumulations": accumulations,
+        "simultaneous_impacts": run.simultaneous_impacts,
         "energy_model": "linear quadratic form: KE = 1/2 p^T Theta p, PE = m g h",
         "linear_final": {"q": run.q_post[-1].tolist(), "p": run.p_post[-1].tolist()},
     }
