@@ -4,7 +4,7 @@ chain of tests, one per law with a function, built from the registry."""
 import importlib
 
 from .impact_laws import NOT_SETTLED
-from .jit import hot
+from .jit import hot, hot_inline
 from .laws import LAWS
 
 
@@ -33,7 +33,9 @@ def _no_law(code, W, u_pre, gamma, k, lam, u_post, work):
 
 
 def _link(code, impulses, rest):
-    @hot
+    # inlined by numba (its IR): the chain is one function in its caller, so each law
+    # function is linked into the caller once, not once more per link of the chain
+    @hot_inline
     def solve(law, W, u_pre, gamma, k, lam, u_post, work):
         if law == code:
             return impulses(W, u_pre, gamma, k, lam, u_post, work)

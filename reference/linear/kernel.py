@@ -47,7 +47,8 @@ another contact is then at the ground within roundoff, the accumulation is undec
 Code layout.  `start_kernel` sets up, `continue_kernel` runs `_step` (at most a budget of
 passes per call, so that Python sees Ctrl-C between calls) until a status is set: an impact
 now (`_impact_step`: the impact map, renormalisation, chatter completion), else the held
-set and the motion to the next event (`_flight_step`).  The helpers share the run through
+set and the motion to the next event (`_flight_step`), then, where the paper's rule stopped
+undecided under a law, the law's event (`_law_event`).  The helpers share the run through
 small tuples and arrays, unpacked at their top:
 
     model   = (F, thd, tinv, w, wmax, mass, gamma, rank_f)   constants of the body
@@ -86,6 +87,11 @@ from .model import energy as model_energy
 # helpers, e.g. numba.misc.mergesort).  Measured: as ordinary njit functions the split
 # event loop ran 2.5-3 times slower than the single function it replaced.
 _helper = njit(cache=True, forceinline=True, _nrt=False)
+# The law event's helpers: inlined by numba into `_law_event` in its own IR
+# (inline="always"), so that the law's code -- the exact core's law functions, linked
+# into every function that calls them, each optimising it again -- sits in one function
+# called from the top of the loop (`continue_kernel`), not under a chain of helpers.
+_law_helper = njit(cache=True, inline="always", _nrt=False)
 
 # event kinds
 INITIAL, IMPACT, ACCUMULATION, END = 0, 1, 2, 3
@@ -1057,7 +1063,7 @@ def law_contacts(F, q, p, qs, ps, vfl, together, with_together, out):
     return n
 
 
-@_helper
+@_law_helper
 def _law_progress(si, sf, e_true):
     """Whether the law may act at this stop: the time moved since the last law event,
     or the true energy fell below half its value there (a cascade of simultaneous
@@ -1072,7 +1078,7 @@ def _law_progress(si, sf, e_true):
     return si[SI_LAW_REPEATS] < LAW_MAX_REPEATS
 
 
-@_helper
+@_law_helper
 def _law_failed(si, info, together, contacts, k, outcome, hits):
     """End the run undecided by the law (SIMULTANEOUS, REASON_LAW_UNDECIDED): its outcome
     and single impacts into info, the contacts of the impact flagged in `together`."""
@@ -1085,7 +1091,7 @@ def _law_failed(si, info, together, contacts, k, outcome, hits):
     _stop(si, info, SIMULTANEOUS, REASON_LAW_UNDECIDED, -1, -1)
 
 
-@_helper
+@_law_helper
 def _any_approaching(F, p, ps, vfl, contacts, k):
     """Whether a contact of contacts[:k] approaches beyond roundoff."""
     for i in range(k):
@@ -1095,7 +1101,7 @@ def _any_approaching(F, p, ps, vfl, contacts, k):
     return False
 
 
-@_helper
+@_law_helper
 def _law_impulses(model, law, p, contacts, k, gamma, lawws):
     """(status, single impacts) of the run's law on contacts[:k] (the exact core's law
     functions through its dispatch, law_dispatch.solve_law): Delassus matrix
@@ -1123,7 +1129,7 @@ def _law_impulses(model, law, p, contacts, k, gamma, lawws):
     return solve_law(law, W, u_pre, gamma, k, lam, u_post, work)
 
 
-@_helper
+@_law_helper
 def _add_law_impulses(F, tinv, contacts, k, lam, p):
     """p ← p + Θ⁻¹F_SᵀΛ, contact by contact (as `_apply_impulse`)."""
     for i in range(k):
@@ -1133,7 +1139,7 @@ def _add_law_impulses(F, tinv, contacts, k, lam, p):
                 p[j] += tinv[j] * F[c, j] * lam[i]
 
 
-@_helper
+@_law_helper
 def _law_completes(u_post, k, gamma, below):
     """Whether, with 0 < γ < 1, some contact leaves the impact (u⁺ above LEAVING_ULPS
     ulps of `below`) and every one that does leaves at u⁺ ≤ `below`: the bounces that
@@ -1150,7 +1156,7 @@ def _law_completes(u_post, k, gamma, below):
     return leaving
 
 
-@_helper
+@_law_helper
 def _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q, p_pre, p):
     """One IMPACT row per contact that took an impulse, at the impact's time (the first
     carries the interval before it, the others 0)."""
@@ -1169,7 +1175,7 @@ def _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q, p_pre, p
     sf[SF_DT_PENDING] = 0.0
 
 
-@_helper
+@_law_helper
 def _rest_acceleration(F, tinv, g, rest, m, acc):
     """The constant acceleration with the m ≤ 2 contacts rest[:m] held (F_B Θ⁻¹ F_Bᵀ η
     = g 1, ṗ = Θ⁻¹F_Bᵀη − g u3: the paper, section 2.5, eq. pacccontact) into acc;
@@ -1199,13 +1205,13 @@ def _rest_acceleration(F, tinv, g, rest, m, acc):
     return True
 
 
-@_helper
+@_law_helper
 def _theta_dot(thd, x, y):
     """xᵀΘy."""
     return x[0] * (thd[0] * y[0]) + x[1] * (thd[1] * y[1]) + x[2] * (thd[2] * y[2])
 
 
-@_helper
+@_law_helper
 def _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, a):
     """κ of the self-similar bounce series a law impact at q = 0 (every contact touching)
     that left p⁺ = p may start (`_bounce_series`), with the contacts left resting (|u⁺|
@@ -1236,7 +1242,7 @@ def _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, a):
     return kappa, m
 
 
-@_helper
+@_law_helper
 def _series_maps_back(model, law, p, contacts, k, lawws, pn, miss):
     """Whether the law maps −p⁺ (p⁺ = p) to γp⁺ (to SELF_SIMILAR_TOL, in the Θ norm):
     every bounce of the series is then the first × γ^(j−1).  Leaves the law's impulses,
@@ -1254,7 +1260,7 @@ def _series_maps_back(model, law, p, contacts, k, lawws, pn, miss):
     return _theta_dot(thd, miss, miss) <= SELF_SIMILAR_TOL**2 * _theta_dot(thd, p, p)
 
 
-@_helper
+@_law_helper
 def _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts, k, flight, m):
     """The bounces of a self-similar series after the law impact at the current time, p⁺
     = p (`_bounce_series`): bounce j at t + flight (1 − γʲ)/(1 − γ), one IMPACT row per
@@ -1308,7 +1314,7 @@ def _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts, k,
     return last_hi, last_lo
 
 
-@_helper
+@_law_helper
 def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, vfl):
     """After a law impact at q = 0 with every contact touching (p⁺ = p): the Zeno series
     of self-similar bounces, completed in closed form when there is one (docs/laws.md,
@@ -1352,7 +1358,7 @@ def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, cont
     return True
 
 
-@_helper
+@_law_helper
 def _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, E, vfl):
     """The impact of contacts[:k] under the run's law (`_law_event`): Λ, p⁺ = p⁻ +
     Θ⁻¹F_SᵀΛ, one IMPACT row per contact that took an impulse; bounces too small to
@@ -1391,7 +1397,7 @@ def _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contact
                               contacts, k, vfl)  # fmt: skip
 
 
-@_helper
+@_law_helper
 def _go_on(model, state, out, si, sf, info):
     """Go on after a law event as from a start (`_start`) at the state (q, p): the
     scales renormalised, the contacts resting there closed, the held set (none until
@@ -1462,10 +1468,11 @@ def _law_event(model, limits, state, scratch, out, si, sf, info, lawws):
 
 
 @_helper
-def _step(model, limits, state, scratch, ring, out, si, sf, info, lawws):
+def _step(model, limits, state, scratch, ring, out, si, sf, info):
     """One pass of the event loop: two contacts hitting at once (undecidable, the paper,
-    section 2.3), one (`_impact_step`) or none (`_flight_step`); where the paper's rule
-    stops undecided, the run's impact law resolves the impact (`_law_event`)."""
+    section 2.3), one (`_impact_step`) or none (`_flight_step`).  Where the paper's rule
+    stops undecided, `continue_kernel` has the run's impact law resolve the impact
+    (`_law_event`)."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
     q, p, qs, ps, acc, held, closed = state
     E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
@@ -1477,8 +1484,6 @@ def _step(model, limits, state, scratch, ring, out, si, sf, info, lawws):
         _impact_step(model, limits, state, scratch, ring, out, si, sf, info, cand, E, vfl)
     else:
         _flight_step(model, limits, state, scratch, out, si, sf, info, vfl)
-    if si[SI_STATUS] == SIMULTANEOUS and limits[7] != LAW_PAPER:
-        _law_event(model, limits, state, scratch, out, si, sf, info, lawws)
 
 
 @_helper
@@ -1590,7 +1595,8 @@ def continue_kernel(
     q, p, qs, ps, acc, held, closed, si, sf, rb_c, rb_ldt, rb_lu, together,
     law_mats, law_vecs, law_ints, law_order, budget,
 ):  # fmt: skip
-    """At most `budget` passes of the event loop (`_step`), so that the caller regains
+    """At most `budget` passes of the event loop (`_step`, then `_law_event` at a stop
+    SIMULTANEOUS under a law other than `paper`), so that the caller regains
     control (Ctrl-C) between calls.  Returns the number of events once a status is set
     (after `_finish`: END row, outcome record), else -1: call again.  `law`: the code
     of the run's impact law (reference.core.laws); law_*: its scratch
@@ -1609,7 +1615,9 @@ def continue_kernel(
     ring = (rb_c, rb_ldt, rb_lu)
     steps = 0
     while si[SI_STATUS] < 0 and steps < budget:
-        _step(model, limits, state, scratch, ring, out, si, sf, info, lawws)
+        _step(model, limits, state, scratch, ring, out, si, sf, info)
+        if si[SI_STATUS] == SIMULTANEOUS and law != LAW_PAPER:
+            _law_event(model, limits, state, scratch, out, si, sf, info, lawws)
         steps += 1
     if si[SI_STATUS] < 0:
         return -1
