@@ -15,6 +15,12 @@ than a test before every division to raise ZeroDivisionError (Python's model, nu
 default): the loop ends a run whose state is not finite with an explicit status
 (STATUS_FAILED_NONFINITE), and the tests cost ~2 % of a run's instructions (callgrind,
 five bench runs; results bit-identical on 17 check scenes).
+One signature per event function: numba compiles a function once per tuple of argument
+types, types a constant argument as its value (`Literal[int](0)`) and a record's array
+field as a nested array of its length, and every signature compiles the function and
+everything it calls again.  The calls of the impact events (`events.resolve_impact`,
+its law path) therefore pass counts as `np.int64(k)` and a record's contact list as a
+view (`state.active[:]`): the law's chain is compiled once, not once per call site.
 """
 
 from numba import njit

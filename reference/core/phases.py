@@ -5,6 +5,8 @@ grow the arrays and redo it identically."""
 
 import math
 
+import numpy as np
+
 from .candidates import (
     certified_horizon,
     is_held,
@@ -148,7 +150,18 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
         activate(state, model, pts, ws, stats, cs.together, ev.n_together)
         return DONE
     resolve_impact(
-        state, model, pts, opts, stats, out, ws, cs, cs.together, ev.n_together, state.active, 0
+        state,
+        model,
+        pts,
+        opts,
+        stats,
+        out,
+        ws,
+        cs,
+        cs.together,
+        ev.n_together,
+        state.active[:],
+        np.int64(0),  # one signature of resolve_impact (jit.py)
     )
     return DONE
 
@@ -268,7 +281,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
         for i in range(state.n_active):
             ws.held[i] = state.active[i]
         resolve_impact(
-            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, ws.held, state.n_active
+            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, ws.held[:], state.n_active
         )
         return True
     if n_land:
@@ -406,7 +419,7 @@ def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed
             cs,
             cs.hitting,
             n_hit,
-            ws.held,
+            ws.held[:],
             state.n_active,
         )
         return DONE
