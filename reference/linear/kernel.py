@@ -72,6 +72,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import clear_stale_jit_cache
 from ..core.clock import time_until
 from ..core.impact import bounce_ratio, chatter_impulse, impact_impulse, post_impact_velocity
 from ..core.impact_laws import MAX_SEQUENTIAL_IMPACTS, SETTLED
@@ -81,6 +82,10 @@ from ..core.laws import LAW_PAPER
 from ..core.records import LawWork
 from ..core.tolerances import EPS  # unit roundoff of a double (one definition)
 from .model import energy as model_energy
+
+# numba's cache of this kernel holds the core's functions it calls: dropped when any of
+# the core's or the linear model's sources changed (reference.compiled)
+clear_stale_jit_cache()
 
 # The event loop's helpers allocate nothing: they are compiled inline into continue_kernel
 # (LLVM alwaysinline) and without reference counting (numba's own idiom for allocation-free
