@@ -48,7 +48,7 @@ $(STAMP_ALL): $(BUILD_DEPS)
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
-	@echo "set-up 3/3: the reference's compiled core (about 100 s on one core, beside step"
+	@echo "set-up 3/3: the reference's compiled core (about 3 min on one core, beside step"
 	@echo "  2/3; rebuilt when its sources change)"
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)

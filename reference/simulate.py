@@ -287,8 +287,9 @@ def impact_law_of(scene: Scene, opts: ReferenceOptions) -> tuple[str, float]:
     return check_impact_law(law), check_window_bound(scene, check_window(window))
 
 
-# A rough cost of compiling the loop just in time on a 2-core machine (measured).
-JIT_COMPILE_ESTIMATE_S = 60
+# A rough cost of compiling the loop just in time on a 2-core machine (measured: 169 s of
+# CPU, numba's compile events; docs/development.md).
+JIT_COMPILE_ESTIMATE_S = 170
 _event_loop_loaded = False
 
 
