@@ -44,13 +44,19 @@ _aot_checked = False
 _cache_checked = False
 
 
+def _sources_stamp(folders) -> str:
+    """SHA-256 of the source files of `folders`, file by file (name, then content)."""
+    h = hashlib.sha256()
+    for folder in folders:
+        for path in sorted(folder.glob("*.py")):
+            h.update(path.name.encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
 def source_stamp() -> str:
     """SHA-256 of the core's source files (what the ahead-of-time module was built from)."""
-    h = hashlib.sha256()
-    for path in sorted(CORE_DIR.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
-    return h.hexdigest()
+    return _sources_stamp((CORE_DIR,))
 
 
 def _load_aot():
@@ -75,17 +81,6 @@ def fresh_aot_module():
         return None
 
 
-def _jit_sources_stamp() -> str:
-    """SHA-256 of the source files whose machine code numba caches: the core's and the
-    linear model's (its kernel calls the core's functions)."""
-    h = hashlib.sha256()
-    for folder in JIT_CACHED:
-        for path in sorted(folder.glob("*.py")):
-            h.update(f"{folder.name}/{path.name}".encode())
-            h.update(path.read_bytes())
-    return h.hexdigest()
-
-
 def clear_stale_jit_cache() -> None:
     """numba's cache does not notice that a function called from another module has
     changed; after any change to the core's or the linear model's sources the cached
@@ -96,7 +91,7 @@ def clear_stale_jit_cache() -> None:
         return
     _cache_checked = True
     stamp_file = CORE_DIR / "__pycache__" / "jit.stamp"
-    stamp = _jit_sources_stamp()
+    stamp = _sources_stamp(JIT_CACHED)  # the linear kernel calls the core's functions
     try:
         if stamp_file.read_text().strip() == stamp:
             return

@@ -149,21 +149,23 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
     if ev.kind == EVENT_ACTIVATION:
         activate(state, model, pts, ws, stats, cs.together, ev.n_together)
         return DONE
-    resolve_impact(
-        state,
-        model,
-        pts,
-        opts,
-        stats,
-        out,
-        ws,
-        cs,
-        cs.together,
-        ev.n_together,
-        state.active[:],
-        np.int64(0),  # one signature of resolve_impact (jit.py)
-    )
+    resolve_impact(  # no contact held in flight; one signature of resolve_impact (jit.py)
+        state, model, pts, opts, stats, out, ws, cs, cs.together, ev.n_together,
+        state.active[:], np.int64(0),
+    )  # fmt: skip
     return DONE
+
+
+@hot_inline
+def _impact_with_held(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit):
+    """The impact of hitting[:n_hit] with the contacts held (state.active) as the resting
+    ones: those copied to ws.held first, since resolve_impact changes state.active; passed
+    as a view, so that resolve_impact has one signature (jit.py)."""
+    for i in range(state.n_active):
+        ws.held[i] = state.active[i]
+    resolve_impact(
+        state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, ws.held[:], state.n_active
+    )
 
 
 @hot_inline
@@ -278,11 +280,7 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
             cs, n_cand, first, n_hit, vnoise, gap_res, model.window_per_speed
         )
         close_contact_phase(state, model, stats, out)
-        for i in range(state.n_active):
-            ws.held[i] = state.active[i]
-        resolve_impact(
-            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, ws.held[:], state.n_active
-        )
+        _impact_with_held(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit)
         return True
     if n_land:
         close_contact_phase(state, model, stats, out)
@@ -406,22 +404,7 @@ def _touching_now(state, model, pts, opts, stats, out, ws, cs, s_star, n_crossed
     close_contact_phase(state, model, stats, out)
     n_hit = _approaching(state.y, model, pts, cs.together, n_crossed, cs.hitting)
     if n_hit:
-        for i in range(state.n_active):
-            ws.held[i] = state.active[i]
-        resolve_impact(
-            state,
-            model,
-            pts,
-            opts,
-            stats,
-            out,
-            ws,
-            cs,
-            cs.hitting,
-            n_hit,
-            ws.held[:],
-            state.n_active,
-        )
+        _impact_with_held(state, model, pts, opts, stats, out, ws, cs, cs.hitting, n_hit)
         return DONE
     activate(state, model, pts, ws, stats, cs.together, n_crossed)
     return DONE
