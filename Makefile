@@ -48,7 +48,7 @@ $(STAMP_ALL): $(BUILD_DEPS)
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
-	@echo "set-up 3/3: the reference's compiled core (about 3 min on one core, beside step"
+	@echo "set-up 3/3: the reference's compiled core (about 2–3 min on one core, beside step"
 	@echo "  2/3; rebuilt when its sources change)"
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)
@@ -81,9 +81,11 @@ demo: $(BUILD_DEPS)
 # The suite starts hundreds of Python processes (every worker, every CLI test): byte-code
 # caches are written even where the environment sets PYTHONDONTWRITEBYTECODE, so that each
 # process reads the project's modules (and pytest its rewritten tests) compiled once.
+# --dist loadgroup: a module marked xdist_group runs on one worker (test_engine_mjx: its
+# tests share compiled programs); every other test goes to whichever worker is free.
 TEST_WORKERS ?= auto
 test: setup
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS)
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup
 
 test-slow: setup
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -m slow

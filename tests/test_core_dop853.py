@@ -85,7 +85,7 @@ def test_integration_is_scipys_dop853_step_for_step(two):
     ours = new_work()
     r = integrate_held(
         y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], (0, 1.0, 0), out,
-        (0.0, 0.0), 0, False, np.zeros(0, dtype=np.int64), 0,
+        (0.0, 0.0), 0, False, np.zeros(0, dtype=np.int64), 0, 0.0, False,
     )  # fmt: skip
     assert r.status == INT_DONE
     assert r.nfev == ref.nfev
@@ -115,7 +115,7 @@ def test_crossing_is_located_where_scipys_event_finds_it():
     ws = new_work()[0]
     r = integrate_held(
         y, 2.0, model, pts, idx, m, rtol, atol, ws, ws, (0, 1.0, 0), out,
-        (0.0, 0.0), 0, False, watch, 4,
+        (0.0, 0.0), 0, False, watch, 4, 0.0, False,
     )  # fmt: skip
     assert r.status == INT_CROSSING
     assert abs(r.s - t_ref) < 1e-10

@@ -10,6 +10,7 @@ in time on first use instead.  Why pycc: docs/development.md."""
 from __future__ import annotations
 
 import sys
+import textwrap
 import time
 import warnings
 from pathlib import Path
@@ -72,12 +73,41 @@ def build(output_dir: Path = CORE_DIR) -> Path:
     return output_dir / cc.output_file
 
 
+def signature_counts() -> dict[str, int]:
+    """The number of signatures numba has compiled of each core function compiled in
+    this process, by "module.function" (after `build`: everything under the exported
+    functions; a function inlined by numba, jit.hot_inline, has none of its own)."""
+    from numba.core.registry import CPUDispatcher
+
+    counts = {}
+    for name, module in sorted(sys.modules.items()):
+        if not name.startswith("reference.core."):
+            continue
+        for attr, value in vars(module).items():
+            compiled = isinstance(value, CPUDispatcher) and value.overloads
+            if compiled and value.__module__ == name:
+                counts[f"{name.rsplit('.', 1)[1]}.{attr}"] = len(value.overloads)
+    return counts
+
+
+def repeated_signatures(counts: dict[str, int]) -> str:
+    """One line: how many functions and signatures were compiled, and the functions
+    compiled more than once (jit.py: each signature compiles the function and all it
+    calls again)."""
+    repeated = {k: n for k, n in counts.items() if n > 1}
+    line = f"{len(counts)} functions, {sum(counts.values())} signatures"
+    if not repeated:
+        return line + "; each function compiled once"
+    listed = ", ".join(f"{k} ×{n}" for k, n in sorted(repeated.items()))
+    return f"{line}; compiled more than once: {listed}"
+
+
 def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
     """`build`, timed and announced; when it cannot be done (no C compiler, no
     numba.pycc) one line on stderr says so and None is returned: the loop is then
     compiled just in time on first use."""
     t0 = time.perf_counter()
-    print("building the reference's event loop ahead of time (about 3 min) ...", flush=True)
+    print("building the reference's event loop ahead of time (about 2–3 min) ...", flush=True)
     try:
         path = build(output_dir)
     except Exception as exc:  # any failure: the loop is compiled just in time instead
@@ -86,6 +116,7 @@ def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
               "time on first use", file=sys.stderr)  # fmt: skip
         return None
     print(f"built {path.name} in {time.perf_counter() - t0:.0f} s", flush=True)
+    print(textwrap.fill(repeated_signatures(signature_counts()), 100), flush=True)
     return path
 
 

@@ -13,9 +13,11 @@ with n."""
 import math
 from collections import namedtuple
 
+import numpy as np
+
 from .contacts import contact_jet, contact_kind, rim_jet, vertex_gap_noise
 from .horizon import horizon_bound, local_time_cap, safe_horizon
-from .jit import hot
+from .jit import ZERO, hot
 from .layout import Z
 from .roots import quadratic_taylor_root
 from .tolerances import WINDOW_GROW, WINDOW_MAX, WINDOW_ROUNDS
@@ -63,8 +65,8 @@ def touching_candidates(state, model, pts, opts, acc, cs, touch):
     y = state.y
     n = pts.shape[0]
     if not use_window(model, opts.window_search):
-        m = _list_free(state, cs, 0, n, n, 0)
-        _jets(y, model, pts, acc, cs, 0, m)
+        m = _list_free(state, cs, ZERO, n, n, ZERO)
+        _jets(y, model, pts, acc, cs, ZERO, m)
         acc_scale = 0.0
         for i in range(m):
             acc_scale = max(acc_scale, abs(cs.accel[i]))
@@ -72,9 +74,9 @@ def touching_candidates(state, model, pts, opts, acc, cs, touch):
     _, _, _, _, rx, ry = rim_jet(y, acc, model.radius)
     K = horizon_bound(abs(acc[2]) + math.sqrt(rx * rx + ry * ry), model.gravity)
     lift = max(touch, vertex_gap_noise(y[Z], model.radius))
-    k0, half = vertex_window(y, model.radius, n, K, 0.0, WINDOW_MAX, lift)
-    m = _list_free(state, cs, k0 - half, min(2 * half + 1, n), n, 0)
-    _jets(y, model, pts, acc, cs, 0, m)
+    k0, half = vertex_window(y, model.radius, n, K, 0.0, np.int64(WINDOW_MAX), lift)
+    m = _list_free(state, cs, k0 - half, min(2 * half + 1, n), n, ZERO)
+    _jets(y, model, pts, acc, cs, ZERO, m)
     return Examined(m, K, k0, -half, half, 2 * half + 1 < n)
 
 
@@ -104,13 +106,13 @@ def certified_horizon(state, model, pts, acc, cs, ex, h):
     contact_rtol = 1e-12 a step is a few per cent of it), where L and V can only guess,
     e.g. a disk rocking slowly over the bumps of the three-point ground."""
     cap = max(local_time_cap(state.y, model, ex.K), state.h_next)
-    h = safe_horizon(cs, 0, ex.n, ex.K, min(h, cap))
+    h = safe_horizon(cs, ZERO, ex.n, ex.K, min(h, cap))
     if not ex.windowed:
         return h, ex.n
     n = pts.shape[0]
     lo, hi, m = ex.lo, ex.hi, ex.n
     for _ in range(WINDOW_ROUNDS):
-        nlo, nhi = window_offsets(state.y, model.radius, n, ex.K, h, 0, ex.k0)
+        nlo, nhi = window_offsets(state.y, model.radius, n, ex.K, h, ZERO, ex.k0)
         if nlo >= lo and nhi <= hi:
             return h, m
         nlo, nhi = min(nlo, lo), max(nhi, hi)

@@ -54,7 +54,7 @@ Functions of plain arrays, allocation-free: the caller passes `work`
 
 import math
 
-from .jit import hot
+from .jit import FALSE, TRUE, hot
 
 SETTLED = 0
 NOT_SETTLED = 1
@@ -318,14 +318,14 @@ def compliant_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
     (module docstring): impulses lam[:k] and u_post[:k] = u⁻ + WΛ.  Returns SETTLED,
     NOT_SETTLED (a cap reached: Λ is the state there), SINGULAR (a Wᵢᵢ ≤ 0) or
     TOO_MANY."""
-    return _impulses(W, u_pre, gamma, k, lam, u_post, work, active, False)
+    return _impulses(W, u_pre, gamma, k, lam, u_post, work, active, FALSE)
 
 
 @hot
 def compliant_mass_impulses(W, u_pre, gamma, k, lam, u_post, work, active):
     """`compliant_impulses` with each contact's stiffness in its effective mass, kᵢ ∝
     1/Wᵢᵢ (every contact alone oscillates at one frequency)."""
-    return _impulses(W, u_pre, gamma, k, lam, u_post, work, active, True)
+    return _impulses(W, u_pre, gamma, k, lam, u_post, work, active, TRUE)
 
 
 @hot

@@ -19,7 +19,7 @@ from . import dop853_tableau as tab
 from .clock import grid_time, two_sum_add
 from .contacts import contact_frame, contact_kind
 from .held import held_derivative, held_forces, held_rhs
-from .jit import copy_into, hot, hot_inline
+from .jit import ZERO, copy_into, hot, hot_inline
 from .layout import STATE_SIZE
 from .output import push_sample
 from .tolerances import EPS, LOCATE_ITERATIONS, LOCATE_XTOL
@@ -91,7 +91,7 @@ def heun_euler_step(y, f0, h, rtol, atol, model, pts, idx, m, work, st, y_new):
     result is more accurate still (local extrapolation, as DOP853's own).  For steps
     far below the integrator's (`phases._short_chunk`), where a DOP853 step's 12
     evaluations buy nothing.  Returns the error norm (≤ 1: accepted)."""
-    f1 = st.Ks[0]
+    f1 = st.f1
     for c in range(STATE_SIZE):
         st.ys[c] = y[c] + h * f0[c]
     held_rhs(st.ys, model, pts, idx, m, work, f1)
@@ -337,8 +337,8 @@ def integrate_held(
     watch_forces,
     watch,
     n_watch,
-    h_start=0.0,
-    f_ready=False,
+    h_start,
+    f_ready,
 ):
     """Integrate the held motion from y (in place) over [0, s_end] with scipy's adaptive
     DOP853; grid samples at the grid's local times (grid = (k, dt, n): (k + i)·dt from
@@ -365,7 +365,7 @@ def integrate_held(
         h_abs, n0 = initial_step(y, f, s_end, rtol, atol, model, pts, idx, m, work, st)
         nfev += n0
     t = 0.0
-    gi = 0
+    gi = ZERO
     K, y_new = st.K, st.y_new
     h_next = h_abs
     while t < s_end:

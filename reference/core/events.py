@@ -16,11 +16,12 @@ from .contacts import (
     rate_noise,
     velocity_scale,
 )
+from .ending import end_run
 from .floor import below_floor
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
-from .jit import copy_into, hot, sort_prefix
+from .jit import ZERO, copy_into, hot, sort_prefix
 from .law_event import law_event
 from .laws import LAW_PAPER
 from .output import push_accumulation, push_impact, push_sample
@@ -33,16 +34,6 @@ from .records import (
     STATUS_SIMULTANEOUS,
     STATUS_SINGULARITY,
 )
-
-
-@hot
-def end_run(state, status, contacts, n):
-    """Stop with `status` at the current time, naming contacts[:n]."""
-    state.status = status
-    state.info_t = state.t_hi
-    state.n_info = min(n, state.info.shape[0])
-    for i in range(state.n_info):
-        state.info[i] = contacts[i]
 
 
 @hot
@@ -85,7 +76,7 @@ def _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, res
     """The impact of hitting[:n_hit] with resting[:n_rest] and every contact touching
     them, under the run's impact law (law_event)."""
     named = cs.near  # (free at an event; n long: the contacts named are distinct)
-    m = 0
+    m = ZERO
     for i in range(n_hit):
         named[m] = hitting[i]
         m += 1
@@ -129,7 +120,7 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, 
         return False
     push_impact(out, state.t_hi, state.t_lo, k, out_imp.impulse, out_imp.u_pre, out_imp.u_post)
     small = completion_speed(y, model, pts, k, opts.chatter_tol, vnoise)
-    m = 0
+    m = ZERO
     vs = velocity_scale(y, model.radius)
     for i in range(n_rest):
         kind = contact_kind(pts, resting[i])
@@ -172,7 +163,7 @@ def activate(state, model, pts, ws, stats, landing, n_land):
     only) and solve the LCP over all of them; if it would keep only the ones already
     held (a roundoff tie), hold them all: the contact phase's force check releases any
     that pull."""
-    m = 0
+    m = ZERO
     for i in range(state.n_active):
         ws.cand[m] = state.active[i]
         m += 1
@@ -225,7 +216,7 @@ def start(state, model, pts, opts, stats, out, ws, cs):
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
     if below_floor(y, model):  # (a state given below the floor plane: reference.core.floor)
         state.started = True
-        end_run(state, STATUS_BELOW_FLOOR, cs.together, 0)
+        end_run(state, STATUS_BELOW_FLOOR, cs.together, ZERO)
         return False
     state.started = True
     return resolve_touching(state, model, pts, opts, stats, out, ws, cs)
@@ -240,7 +231,7 @@ def resolve_touching(state, model, pts, opts, stats, out, ws, cs):
     state.recheck = False
     state.n_active = 0
     vnoise = rate_noise(y, model.radius)
-    n_hit = n_rest = 0
+    n_hit = n_rest = ZERO
     hitting, resting = cs.hitting, cs.together
     for k in range(pts.shape[0]):
         kind = contact_kind(pts, k)

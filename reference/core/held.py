@@ -15,7 +15,7 @@ import numpy as np
 
 from .contacts import contact_frame, contact_kind, frame_at, normal_acceleration, normal_velocity
 from .inertia import free_acceleration, response_on_axis
-from .jit import hot, hot_inline
+from .jit import ZERO, hot, hot_inline
 from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y, Z
 from .linalg import solve_small
 from .records import SCRATCH
@@ -233,7 +233,7 @@ def solve_lcp(y, model, pts, cand, m, work, active, tol=0.0):
         for mask in range(1 << m):
             if _popcount(mask) != size or not _lcp_admissible(work, m, mask, tol):
                 continue
-            n = 0
+            n = ZERO
             for i in range(m):
                 if work.lam[i] > 0.0:
                     active[n] = cand[i]

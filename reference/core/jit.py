@@ -21,9 +21,24 @@ field as a nested array of its length, and every signature compiles the function
 everything it calls again.  The calls of the impact events (`events.resolve_impact`,
 its law path) therefore pass counts as `np.int64(k)` and a record's contact list as a
 view (`state.active[:]`): the law's chain is compiled once, not once per call site.
+Everywhere else on the event path a constant argument is one of the typed constants
+below, a counter passed on starts at `ZERO` (numba's type inference first types
+`m = 0` as `Literal[int](0)` and resolves the calls with that type too), an optional
+argument is passed, and a record's arrays of one role share one shape.  The build
+(`python -m reference.core.aot`) lists the functions still compiled more than once:
+`search.examine` and the frame functions under it, specialised on the contact kind on
+purpose (docs/performance.md, "Event search"), and small helpers that the exported
+row functions (`arrays`, `multi_impact`) call with plain arrays.
 """
 
+import numpy as np
 from numba import njit
+
+# Typed constants for calls on the event path: typed as int64 and bool, as the variables
+# at the other call sites are (a literal `0` or `True` is typed as its value).
+ZERO = np.int64(0)
+FALSE = np.bool_(False)
+TRUE = np.bool_(True)
 
 hot = njit(cache=True, _nrt=False, error_model="numpy")
 # `hot`, inlined into its callers by numba (its IR, before LLVM): for a helper that

@@ -32,8 +32,9 @@ import math
 from .chatter import completion_speed
 from .clock import two_sum_add
 from .contacts import contact_frame, contact_kind, normal_velocity, rate_noise
+from .ending import end_run
 from .impact_laws import MAX_SEQUENTIAL_IMPACTS, SETTLED, TOO_MANY
-from .jit import hot, sort_prefix
+from .jit import FALSE, TRUE, ZERO, hot, hot_inline, sort_prefix
 from .law_dispatch import solve_law
 from .layout import QW, QX, QY, QZ, VX, VY, VZ, WX, WY, WZ, X, Y
 from .multi_impact import apply_impulses, delassus_system
@@ -85,14 +86,14 @@ def law_event(state, model, pts, opts, stats, out, ws, cs, named, n_named):
     if _bounces_are_small(y, model, pts, opts, contacts, k, u_post, vnoise):
         if flat:
             return _finish(
-                state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, True, True
+                state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, TRUE, TRUE
             )
         status, _ = solve_law(model.law, W, u_pre, 0.0, k, lam, u_post, work)
         if status != SETTLED:
             return _undecided(state, status, contacts, k)
         stats.chatter_completions += 1
     return _finish(
-        state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, flat, False
+        state, model, pts, opts, stats, out, contacts, k, lam, u_pre, u_post, flat, FALSE
     )
 
 
@@ -131,19 +132,15 @@ def _progress(state):
     return state.law_repeats <= LAW_MAX_REPEATS
 
 
-@hot
+@hot_inline
 def _undecided(state, outcome, contacts, n):
     """End the run STATUS_LAW_UNDECIDED (the law's outcome kept), naming contacts[:n]."""
-    state.status = STATUS_LAW_UNDECIDED
+    end_run(state, STATUS_LAW_UNDECIDED, contacts, n)
     state.law_outcome = outcome
-    state.info_t = state.t_hi
-    state.n_info = min(n, state.info.shape[0])
-    for i in range(state.n_info):
-        state.info[i] = contacts[i]
     return False
 
 
-@hot
+@hot_inline
 def _named(contacts, m, c):
     for i in range(m):
         if contacts[i] == c:
@@ -158,7 +155,7 @@ def touching_set(y, model, pts, named, n_named, contacts, separating):
     `separating`: separating ones too, for a law whose other contacts can push them
     back); returns m, or −1 when they do not fit in `contacts`."""
     cap = contacts.shape[0]
-    m = 0
+    m = ZERO
     for i in range(n_named):
         if not _named(contacts, m, named[i]):
             if m >= cap:
@@ -188,7 +185,7 @@ def order_positions(contacts, k, order, n_order, pos):
     take part, then those of the others by index (none: m = 0, the law's own order)."""
     if n_order == 0:
         return 0
-    m = 0
+    m = ZERO
     for j in range(n_order):
         for i in range(k):
             if contacts[i] == order[j] and not _named(pos, m, i):

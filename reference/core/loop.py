@@ -31,7 +31,8 @@ from numba import njit
 
 from .clock import time_until
 from .contacts import off_face, velocity_scale
-from .events import end_run, resolve_touching, start
+from .ending import end_run
+from .events import resolve_touching, start
 from .inertia import excess_energy
 from .jit import hot, hot_inline
 from .layout import QX, QY, STATE_SIZE, WX, WY

@@ -34,13 +34,14 @@ from .dop853 import (
     initial_step,
     integrate_held,
 )
-from .events import activate, end_run, hold, resolve_impact
+from .ending import end_run
+from .events import activate, hold, resolve_impact
 from .flight import flight_constants, free_flight
 from .floor import below_floor, floor_gap, floor_horizon, floor_reach, has_floor
 from .held import held_forces, held_rhs, project_held
 from .horizon import force_trend_limit
 from .inertia import kinetic_energy, potential_energy
-from .jit import copy_into, hot, hot_inline
+from .jit import FALSE, TRUE, ZERO, copy_into, hot, hot_inline
 from .law_event import law_event
 from .layout import VX, VY, VZ, WX, WY, WZ
 from .output import push_phase, push_sample
@@ -103,6 +104,9 @@ def grid_times(t_hi, t_lo, s_end, dt, limit):
     while n < limit and grid_time(kk + n, dt, t_hi, t_lo) < s_end:
         n += 1
     return kk, dt, n
+
+
+NO_GRID = (ZERO, 1.0, ZERO)  # grid_times' (k, dt, n) of no sample points
 
 
 @hot
@@ -184,7 +188,7 @@ def fly_to(state, model, opts, out, ws, fc, s_end, n_grid):
     t0 = state.t_hi
     state.t_hi, state.t_lo = two_sum_add(state.t_hi, state.t_lo, s_end)
     copy_into(y, ws.y_event)
-    push_phase(out, t0, state.t_hi, PHASE_FLIGHT, state.active, 0)
+    push_phase(out, t0, state.t_hi, np.int64(PHASE_FLIGHT), state.active, ZERO)
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
 
 
@@ -242,7 +246,9 @@ def begin_contact_phase(state, model, opts):
 def close_contact_phase(state, model, stats, out):
     """Record the contact phase that ends now and its energy drift."""
     y = state.y
-    push_phase(out, state.phase_t0, state.t_hi, PHASE_CONTACT, state.active, state.n_active)
+    push_phase(
+        out, state.phase_t0, state.t_hi, np.int64(PHASE_CONTACT), state.active, state.n_active
+    )
     e = kinetic_energy(y, model.mass, model.i1, model.i3) + potential_energy(
         y, model.mass, model.gravity
     )
@@ -261,9 +267,9 @@ def _touching_event(state, model, pts, opts, stats, out, ws, cs, n_cand, gap_res
     as in flight) or at rest accelerating into the ground (gap within max(noise,
     gap_res): an activation) ends the phase.  Returns True if so."""
     vnoise = rate_noise(state.y, model.radius)
-    n_hit = n_land = 0
+    n_hit = n_land = ZERO
     hitting = cs.hitting
-    first = -1
+    first = np.int64(-1)
     for i in range(n_cand):
         if cs.gap[i] > max(cs.noise[i], gap_res):
             continue
@@ -377,9 +383,9 @@ def _crossed(y, state, model, pts, opts, cs, gap_res):
     n = pts.shape[0]
     first, count = 0, n
     if use_window(model, opts.window_search):
-        k0, half = vertex_window(y, model.radius, n, 0.0, 0.0, WINDOW_MAX)
+        k0, half = vertex_window(y, model.radius, n, 0.0, 0.0, np.int64(WINDOW_MAX), 0.0)
         first, count = k0 - half, min(2 * half + 1, n)
-    m = 0
+    m = ZERO
     for i in range(count):
         k = (first + i) % n
         if is_held(state, k):
@@ -426,8 +432,8 @@ def _locate_crossing(state, model, pts, opts, stats, out, ws, cs, h, n_crossed):
     copy_into(ws.y_chunk, ws.y_start)
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
-        ws, ws, (0, 1.0, 0), out, (state.t_hi, state.t_lo), opts.max_samples, False, cs.together,
-        n_crossed,
+        ws, ws, NO_GRID, out, (state.t_hi, state.t_lo), opts.max_samples, FALSE, cs.together,
+        n_crossed, 0.0, FALSE,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
@@ -472,8 +478,8 @@ def contact_step(state, model, pts, opts, stats, out, ws, cs):
     ns0 = out.counts[N_SAMPLES]
     r = integrate_held(
         ws.y_chunk, h, model, pts, state.active, m, opts.contact_rtol, ws.atol, ws,
-        ws, grid, out, (state.t_hi, state.t_lo), opts.max_samples, True, cs.near, n_near,
-        h_start, True,
+        ws, grid, out, (state.t_hi, state.t_lo), opts.max_samples, TRUE, cs.near, n_near,
+        h_start, TRUE,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     return _chunk_outcome(state, model, pts, opts, stats, out, ws, cs, r, h, ns0, remaining)
@@ -519,8 +525,8 @@ def _integrate_to(state, model, pts, opts, stats, out, ws, cs, s):
     copy_into(ws.y_chunk, ws.y_start)
     r = integrate_held(
         ws.y_chunk, s, model, pts, state.active, state.n_active, opts.contact_rtol, ws.atol,
-        ws, ws, (0, 1.0, 0), out, (state.t_hi, state.t_lo), opts.max_samples, False,
-        cs.together, 0,
+        ws, ws, NO_GRID, out, (state.t_hi, state.t_lo), opts.max_samples, FALSE,
+        cs.together, ZERO, 0.0, FALSE,
     )  # fmt: skip
     stats.contact_rhs_evals += r.nfev
     project_held(ws.y_chunk, model, pts, state.active, state.n_active, ws)
@@ -596,7 +602,7 @@ def _short_chunk(state, model, pts, opts, stats, out, ws, cs, h, n_near, t_near,
     s = 0.5 * t_near if n_near else h
     if not (s <= h and s <= HEUN_STEP_RATIO * state.h_next):
         return False
-    if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0 or _needed(0, out, opts):
+    if grid_count(state.t_hi, state.t_lo, s, opts.sample_dt) > 0 or _needed(ZERO, out, opts):
         return False
     y, m = state.y, state.n_active
     _chunk_tolerances(y, model, opts, ws.atol, s)
@@ -660,7 +666,7 @@ def _lift_off(state, model, pts, opts, stats, out, ws, r):
         copy_into(y, ws.y_chunk)
     push_sample(out, state.t_hi, state.t_lo, y, model, opts.max_samples)
     close_contact_phase(state, model, stats, out)
-    m = 0
+    m = ZERO
     for i in range(state.n_active):
         if i != r.leaving:
             ws.cand[m] = state.active[i]

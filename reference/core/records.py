@@ -201,8 +201,10 @@ SCRATCH = np.dtype(
         ("geo", np.float64, (3, 6)),  # normal and lever per contact
         ("K", np.float64, (16, STATE_SIZE)),  # DOP853 stages, f(y_new), dense-output stages
         ("F", np.float64, (7, STATE_SIZE)),  # dense-output coefficients of a step
-        ("Ks", np.float64, (13, STATE_SIZE)),  # stages of one-step evaluations
+        # stages of one-step evaluations (K's shape: dop853_step has one signature)
+        ("Ks", np.float64, (16, STATE_SIZE)),
         ("f", np.float64, (STATE_SIZE,)),
+        ("f1", np.float64, (STATE_SIZE,)),  # f at the end of heun_euler_step's Euler step
         ("y_new", np.float64, (STATE_SIZE,)),
         ("ys", np.float64, (STATE_SIZE,)),
         ("scale", np.float64, (STATE_SIZE,)),

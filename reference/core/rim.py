@@ -9,7 +9,7 @@ vertex's, for any n (reference.core.search)."""
 import math
 
 from .flight import centre_height, precession_axis, rodrigues_parts
-from .jit import hot
+from .jit import ZERO, hot
 from .layout import VZ, Z
 from .roots import quadratic_first_root
 from .rotation import body_axis
@@ -106,7 +106,7 @@ def circle_root(z, vz, g, B, px, py, qx, qy, rn):
             break
         lo, flo = hi, fhi
         hi *= 2.0
-    push = 0
+    push = ZERO
     for _ in range(100):
         if hi - lo <= CIRCLE_STEP_REL_TOL * hi:
             break

@@ -21,6 +21,8 @@ grow with n."""
 
 import math
 
+import numpy as np
+
 from .contacts import (
     contact_jet,
     contact_kind,
@@ -32,7 +34,7 @@ from .contacts import (
     time_resolution,
 )
 from .flight import bound_segment, flight_acceleration, flight_bounds, free_flight
-from .jit import copy_into, hot
+from .jit import ZERO, copy_into, hot
 from .layout import VZ, Z
 from .records import (
     EVENT_ACTIVATION,
@@ -165,13 +167,13 @@ def near_vertices_step(y, acc, jet, pts, radius, n, K, B, left, last_dlt, vnoise
     holds for the others if those outside window(δ) are safe by P2 and those inside have
     been examined: at most SEARCH_WINDOW_GROW more are, δ being shortened by
     SEARCH_SHRINK (from 4× the last certified step) until that suffices."""
-    k0, h = vertex_window(y, radius, n, K, 0.0, 2)
+    k0, h = vertex_window(y, radius, n, K, 0.0, np.int64(2), 0.0)
     examine_window(y, acc, jet, pts, n, K, B, k0, h, vnoise, res, radius)
     if res[HIT_K] >= 0 or res[LAND_K] >= 0 or 2 * h + 1 >= n:
         return math.inf
     dlt = min(res[STEP], left, 4.0 * last_dlt)
     while True:
-        lo1, hi1 = window_offsets(y, radius, n, K, dlt, 3, k0)
+        lo1, hi1 = window_offsets(y, radius, n, K, dlt, np.int64(3), k0)
         if hi1 - lo1 + 1 < n and max(hi1 - h, 0) + max(-h - lo1, 0) <= SEARCH_WINDOW_GROW:
             break
         dlt *= SEARCH_SHRINK
@@ -216,7 +218,7 @@ def _search_step(y, fc, acc, model, pts, bounds, vnoise, windowed, left, last_dl
             d_c = rim_descent(y, fc, model, bounds.depth, left, d_c)
         return _shorter(d_c, other, other_k, res), last_dlt
     if not windowed:
-        examine_range(y, acc, jet, pts, n_rim, K, B, 0, n_rim, vnoise, res, model.radius)
+        examine_range(y, acc, jet, pts, n_rim, K, B, ZERO, n_rim, vnoise, res, model.radius)
         return _shorter(max(res[STEP], rim), other, other_k, res), last_dlt
     cap = near_vertices_step(
         y, acc, jet, pts, model.radius, n_rim, K, B, left, last_dlt, vnoise, res
@@ -251,7 +253,7 @@ def _others_safe_time(y, acc, model, pts, k, end, floor, K, B, windowed, vnoise)
     n = pts.shape[0]
     first, half = 0, n // 2
     if windowed:
-        first, half = vertex_window(y, model.radius, n, K, end, 3)
+        first, half = vertex_window(y, model.radius, n, K, end, np.int64(3), 0.0)
     t = end
     cols = rotation_columns_xy(y)
     nxt = (first - half) % n
@@ -362,7 +364,7 @@ def _candidates(y, model, pts, bounds, windowed):
     around the lowest direction, every contact when half = n // 2."""
     n = pts.shape[0]
     if windowed:
-        return vertex_window(y, model.radius, n, bounds.K, 0.0, 3)
+        return vertex_window(y, model.radius, n, bounds.K, 0.0, np.int64(3), 0.0)
     return 0, n // 2
 
 
@@ -394,7 +396,7 @@ def collect_together(y, model, pts, bounds, windowed, k0, vnoise, together):
 @hot
 def collect_landing(y, acc, model, pts, bounds, windowed, vnoise, together):
     """Contacts touching at rest and accelerating into the ground at state y."""
-    count = 0
+    count = ZERO
     n = pts.shape[0]
     first, half = _candidates(y, model, pts, bounds, windowed)
     nxt = (first - half) % n

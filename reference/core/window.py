@@ -28,7 +28,7 @@ def use_window(model, window_search):
 
 
 @hot
-def vertex_window(y, radius, n, K, delta, margin, lift=0.0):
+def vertex_window(y, radius, n, K, delta, margin, lift):
     """The vertices whose P2 can come within `lift` of the ground within δ (the others
     are safe by P2): the index range k0 − half … k0 + half (mod n) around the lowest
     direction, `margin` more on each side; O(1).
@@ -87,7 +87,7 @@ def direction_angle(x, y):
 @hot
 def window_offsets(y, radius, n, K, delta, margin, k0):
     """vertex_window(δ) as offsets (lo, hi) from vertex k0 (in (−n/2, n/2])."""
-    k1, h1 = vertex_window(y, radius, n, K, delta, margin)
+    k1, h1 = vertex_window(y, radius, n, K, delta, margin, 0.0)
     d = (k1 - k0) % n
     if d > n // 2:
         d -= n
