@@ -26,8 +26,8 @@ BUILD_REQUIRES = $(shell $(PYTHON) -c 'import shlex, tomllib; print(shlex.join(t
 
 $(BUILD_DEPS): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), sys.version' || { echo "need Python >= 3.11 (make PYTHON=/path/to/python3.11)"; exit 2; }
-	@echo "set-up 1/3: a virtual environment in $(VENV) (Python: $(PYTHON)), pip, and what the"
-	@echo "  reference's compiled core is built with ($(BUILD_REQUIRES))"
+	@echo "set-up 1/3: a virtual environment in $(VENV), pip, and what the reference's compiled"
+	@echo "  core is built with ($(BUILD_REQUIRES)); Python: $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --progress-bar off --upgrade pip
 	$(BIN)/pip install --progress-bar off $(BUILD_REQUIRES)
@@ -81,11 +81,12 @@ demo: $(BUILD_DEPS)
 # The suite starts hundreds of Python processes (every worker, every CLI test): byte-code
 # caches are written even where the environment sets PYTHONDONTWRITEBYTECODE, so that each
 # process reads the project's modules (and pytest its rewritten tests) compiled once.
-# --dist loadgroup: a module marked xdist_group runs on one worker (test_engine_mjx: its
-# tests share compiled programs); every other test goes to whichever worker is free.
+# --dist loadfile: each test file runs whole on one worker, so that its module-scoped
+# fixtures (the report's documents), the compilations its tests share (the integrator's
+# tests, MJX's scans) and its imports are done once, not once per worker.
 TEST_WORKERS ?= auto
 test: setup
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadgroup
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile
 
 test-slow: setup
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -m slow

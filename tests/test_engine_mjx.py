@@ -27,10 +27,6 @@ from reference.simulate import simulate  # noqa: E402
 
 STEPS = 60  # steps of each short run: 30 before the first impact, 30 after
 
-# one worker runs the module (`make test`: --dist loadgroup): its tests share the compiled
-# scans (engines.mjx.compiled_scan), which a second worker would compile again
-pytestmark = pytest.mark.xdist_group("mjx")
-
 
 @pytest.fixture(scope="module")
 def bounce():

@@ -51,11 +51,6 @@ def _harness(argv: list[str], stdout=subprocess.PIPE) -> subprocess.CompletedPro
     )
 
 
-# one worker runs the module (`make test`: --dist loadgroup): its tests share the
-# module's result documents, which a second worker would compute again
-pytestmark = pytest.mark.xdist_group("report")
-
-
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
     """One small result document of every kind (written as the commands write them)."""
