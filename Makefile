@@ -27,7 +27,8 @@ BUILD_REQUIRES = $(shell $(PYTHON) -c 'import shlex, tomllib; print(shlex.join(t
 $(BUILD_DEPS): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), sys.version' || { echo "need Python >= 3.11 (make PYTHON=/path/to/python3.11)"; exit 2; }
 	@echo "set-up 1/3: a virtual environment in $(VENV), pip, and what the reference's compiled"
-	@echo "  core is built with ($(BUILD_REQUIRES)); Python: $(PYTHON)"
+	@echo "  core is built with ($(BUILD_REQUIRES)); Python:"
+	@echo "  $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --progress-bar off --upgrade pip
 	$(BIN)/pip install --progress-bar off $(BUILD_REQUIRES)
