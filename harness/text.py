@@ -57,6 +57,21 @@ def format_simulate(
     return "\n".join(lines)
 
 
+def wrap_first_column(rows: list[list[str]], header: list[str], width: int) -> list[list[str]]:
+    """rows with each first cell longer than the room `width` leaves it (the other
+    columns at their widths, two spaces apart) broken over lines of its own, the row's
+    other cells on its first line: a long name keeps a table within `width` columns."""
+    others = sum(max(len(h), *(len(r[i]) for r in rows)) + 2 for i, h in enumerate(header))
+    others -= max(len(header[0]), *(len(r[0]) for r in rows)) + 2
+    room = max(width - others - 2, len(header[0]), 8)
+    out = []
+    for row in rows:
+        pieces = textwrap.wrap(row[0], room) or [""]  # at spaces and hyphens, else cut
+        out.append([pieces[0], *row[1:]])
+        out += [[p, *([""] * (len(row) - 1))] for p in pieces[1:]]
+    return out
+
+
 def column_tables(
     head: list[str],
     fixed: list[list[str]],

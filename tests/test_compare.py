@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -378,3 +379,16 @@ def test_a_horizon_table_too_wide_for_long_engine_names_is_split_in_two(monkeypa
     heads = [line for line in lines if line.startswith("simulator  ") and "matched" in line]
     assert len(heads) == 3  # the verdict table and the horizon's two
     assert "own 90 %" in heads[2] and "grid 10 %" in heads[1]
+
+
+def test_a_long_engine_name_is_broken_over_lines_within_100_columns(calls):
+    """A plug-in engine's long name: the verdict table breaks it over lines of its own
+    (the row's cells beside its first line) rather than pass 100 columns."""
+    result = C.compare(resolve_scene("pentagon-bounce"), ["mujoco"], dts=[1e-3])
+    name = "an-engine-plugin-whose-name-alone-takes-up-more-than-fifty-columns-of-text"
+    run = dataclasses.replace(result.runs[0], engine=name)
+    text = C.format_compare(dataclasses.replace(result, runs=[run]))
+    assert max(len(line) for line in text.splitlines()) <= 100
+    header = next(i for i, line in enumerate(text.splitlines()) if line.startswith("simulator"))
+    cells = [line.split("  ")[0].strip() for line in text.splitlines()[header + 2 :]]
+    assert "".join(cells).startswith(name)

@@ -12,7 +12,7 @@ from reference.scene import Scene
 from reference.trajectory import Status
 
 from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
-from ..text import column_tables, impact_law_text, table
+from ..text import column_tables, impact_law_text, table, wrap_first_column
 from .branch_text import branch_lines, branch_sentence
 
 if TYPE_CHECKING:
@@ -255,7 +255,11 @@ def _verdict_table(result: CompareResult) -> str:
         )
         if max(len(line) for line in text.splitlines()) <= WIDTH:
             return text + note
-    return text + note
+    # still wider: the simulators' names broken over lines
+    kept = [[r[i] for i in keep] for r in rows]
+    labels = [header[i] for i in keep]
+    wrapped = wrap_first_column(kept, labels, WIDTH)
+    return table(wrapped, labels, align="".join(align[i] for i in keep)) + note
 
 
 def _table_intro(result: CompareResult) -> str:
