@@ -58,7 +58,7 @@ from .stepping import (
 )
 
 PRECISIONS = {"float64": "mjx", "float32": "mjx-f32"}
-# Steps per compiled scan call (the last chunk of a run compiles once more if shorter).
+# Steps per compiled scan call: every chunk runs this one scan (`run_chunk`).
 CHUNK_STEPS = 2_000
 
 
@@ -138,6 +138,22 @@ def compiled_scan(precision: str, steps: int, batched: bool, mx, dx) -> tuple[Ca
     return fn, time.perf_counter() - t0
 
 
+def run_chunk(precision: str, steps: int, batched: bool, mx, dx):
+    """`steps` ≤ CHUNK_STEPS steps from dx (batched: dx stacked over scenes) by the one
+    compiled scan of CHUNK_STEPS steps: (the data at the scan's end, past the steps
+    when steps < CHUNK_STEPS; (qpos, qvel, forces) of the steps, step axis 0 (1 after
+    the batch's); the seconds spent compiling now).  JAX compiles a program per scan
+    length (4–11 s each on this CPU): with one length, runs of every length (a run's
+    last chunk, fidelity's scales and pilot runs) share one program; a shorter chunk
+    computes the steps past it and drops them (at most CHUNK_STEPS − 1: 0.1 s at 58 µs
+    a step here; their time counts in the run's wall time)."""
+    fn, seconds = compiled_scan(precision, CHUNK_STEPS, batched, mx, dx)
+    dx_end, out = fn(mx, dx)
+    if steps < CHUNK_STEPS:
+        out = tuple(x[:, :steps] if batched else x[:steps] for x in out)
+    return dx_end, out, seconds
+
+
 class _Stepper:
     """engines.stepping.Adapter over MJX: one compiled scan per chunk."""
 
@@ -160,16 +176,15 @@ class _Stepper:
         self.compile_s = 0.0
         self.first = 1
 
-    def _run(self, steps: int):
-        fn, seconds = compiled_scan(self.precision, steps, False, self.mx, self.dx)
-        self.compile_s += seconds
-        return fn(self.mx, self.dx)
-
     def advance(self, steps: int) -> Rows:
+        if self.dx is None:
+            raise RuntimeError("the MJX run's last chunk has run: no steps follow it")
         self.first = len(self.rows)
-        self.dx, (qpos, qvel, f) = self._run(steps)
+        dx, (qpos, qvel, f), seconds = run_chunk(self.precision, steps, False, self.mx, self.dx)
+        self.compile_s += seconds
         if self.slots is None:
-            self.slots = contact_slots(self.model, self.scene, self.dx._impl.contact.geom)
+            self.slots = contact_slots(self.model, self.scene, dx._impl.contact.geom)
+        self.dx = dx if steps == CHUNK_STEPS else None  # None: past the run's end
         states = from_mujoco_state(np.asarray(qpos, float), np.asarray(qvel, float))
         self.rows.extend(states)
         self.forces.extend(_per_contact(np.asarray(f, float), self.slots, self.scene.n_contacts))
@@ -318,10 +333,9 @@ def _run_group(scenes: list[Scene], dt: float, t_end: float, precision: str) -> 
     qs, vs, fs = [], [], []
     compile_s, done = 0.0, 0
     while done < n_steps:
-        steps = min(CHUNK_STEPS, n_steps - done)
-        compiled, seconds = compiled_scan(precision, steps, True, mx, dx)
+        steps = min(CHUNK_STEPS, n_steps - done)  # (shorter: the last chunk)
+        dx, (q, v, f), seconds = run_chunk(precision, steps, True, mx, dx)
         compile_s += seconds
-        dx, (q, v, f) = compiled(mx, dx)
         if done == 0:  # every scene of the group has the model's slots
             slots = contact_slots(model, scene0, np.asarray(dx._impl.contact.geom)[0])
         qs.append(np.asarray(q, float))

@@ -9,7 +9,7 @@ import json
 
 import pytest
 
-from harness import simulators
+from harness import child_processes, simulators
 from harness.cli import main
 
 MESSAGE = "the raiser engine takes no scene"
@@ -22,6 +22,13 @@ from reference.scene import SceneError
 def simulate(scene, *, dt=None, t_end=None):
     raise SceneError("{MESSAGE}")
 '''
+
+
+@pytest.fixture(autouse=True)
+def fork_children(monkeypatch):
+    """The tests' monkeypatches reach a capped run's child by fork only (a spawned child
+    imports the modules afresh): fork even where another test has loaded JAX."""
+    monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
 
 
 @pytest.fixture

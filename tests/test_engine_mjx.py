@@ -128,3 +128,21 @@ def test_float32_mjx_runs_in_float32_and_finds_the_impact(bounce):
     assert [e.contact for e in run.impacts][:1] == [first.contact]
     assert abs(run.impacts[0].t + t0 - first.t) < 2 * dt
     assert run.stats["compile_time_s"] >= 0 and run.stats["wall_time_s"] > 0
+
+
+def test_runs_of_other_lengths_share_the_compiled_scan_and_agree_step_for_step(bounce):
+    """Runs of 60 and 50 steps both run the one compiled scan (CHUNK_STEPS steps): the
+    second compiles nothing, and its rows are the first rows of the longer run, bit for
+    bit (the angular velocity but at its last row, which the recording forms at the
+    run's end)."""
+    scene, first = bounce
+    dt = 1e-4
+    short, _ = _before_impact(scene, first.t, dt)
+    longer = mx.simulate_mjx(short, dt)
+    shorter = mx.simulate_mjx(short.with_run(t_end=50 * dt), dt)
+    assert shorter.stats["compile_time_s"] == 0.0
+    n = len(shorter.t)
+    assert 50 <= n < len(longer.t)
+    for field in ("position", "quaternion", "velocity"):
+        assert np.array_equal(getattr(shorter, field), getattr(longer, field)[:n])
+    assert np.array_equal(shorter.angular_velocity[:-1], longer.angular_velocity[: n - 1])

@@ -7,12 +7,21 @@ import math
 import numpy as np
 import pytest
 
+from harness import child_processes
 from harness import stress as S
 from harness.stress import cases as stress_cases
 from harness.stress import judge as stress_judge
 from harness.stress import study as stress_study
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
 from reference.trajectory import ImpactEvent, Status, Trajectory
+
+
+@pytest.fixture(autouse=True)
+def fork_children(monkeypatch):
+    """The tests' monkeypatches reach a capped run's child by fork only (a spawned child
+    imports the modules afresh): fork even where another test has loaded JAX."""
+    monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
+
 
 CONTRACT_ROW = {
     "case",

@@ -209,7 +209,7 @@ def _boom_on_sample_1(config, rho, gamma, q0, p0):
 
 
 def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
-    import harness.sweep.executors as executors
+    import harness.child_processes as child_processes
     import harness.sweep.run as sr
 
     real = sr.run_linear_sample
@@ -224,7 +224,7 @@ def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
     monkeypatch.setattr(sr, "run_linear_sample", flaky)
     # the patched function reaches the pool's workers by fork only (a spawned worker
     # imports the module afresh): fork even where another test has loaded JAX
-    monkeypatch.setattr(executors, "THREADED_RUNTIMES", ())
+    monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
     cfg = small_config(samples=2)
     doc = exponent_sweep(cfg, tmp_path, workers=1, figures=False, bar=False)
     df = rows(tmp_path)

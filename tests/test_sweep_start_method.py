@@ -1,8 +1,11 @@
-"""The local sweep pool forks only where forking is safe."""
+"""Child processes (the sweep's pool, a capped engine run) fork only where forking is safe."""
 
+import functools
+import multiprocessing
 import sys
 
-from harness.sweep.executors import start_method
+from harness.child_processes import start_method
+from harness.stress.budget import run_capped
 
 
 def test_the_pool_forks_when_no_threaded_runtime_is_loaded(monkeypatch):
@@ -18,3 +21,14 @@ def test_the_pool_spawns_once_jax_is_loaded(monkeypatch):
 def test_the_pool_spawns_where_the_platform_cannot_fork(monkeypatch):
     monkeypatch.delitem(sys.modules, "jax", raising=False)
     assert start_method(["spawn"]) == "spawn"
+
+
+def test_a_capped_run_is_spawned_once_jax_is_loaded_and_answers(monkeypatch):
+    """With JAX loaded a capped engine run's child is spawned, not forked (a forked
+    child hung in `harness fidelity … --engine mjx`), and still returns its answer."""
+    monkeypatch.setitem(sys.modules, "jax", object())
+    methods = []
+    real = multiprocessing.get_context
+    monkeypatch.setattr(multiprocessing, "get_context", lambda m: methods.append(m) or real(m))
+    assert run_capped(functools.partial(pow, 2, 10), 120.0) == (1024, None)
+    assert methods == ["spawn"]

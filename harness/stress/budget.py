@@ -12,6 +12,7 @@ from reference.scene import Scene
 from reference.simulate import ReferenceOptions, simulate
 from reference.trajectory import Status, Trajectory
 
+from ..child_processes import start_method
 from ..simulators import run_simulator
 
 # Engines: runs longer than this many steps are predicted from pilots first.
@@ -83,21 +84,18 @@ def over_budget(predicted: float, budget: float) -> str:
 def run_capped(
     fn: Callable[[], Any], cap_s: float, tick: Callable[[], None] | None = None
 ) -> tuple[Any, str | None]:
-    """fn() in a forked child process, stopped after cap_s seconds of wall time; `tick()`
-    is called about every TICK_S while it runs (a progress line).
+    """fn() in a child process (forked, or spawned where forking is unsafe:
+    harness.child_processes; fn must then be picklable, e.g. a functools.partial of a
+    module-level function), stopped after cap_s seconds of wall time; `tick()` is called
+    about every TICK_S while it runs (a progress line).
 
     Returns (result, None) when it answered, (None, None) when it was stopped at the
     cap (the child, and only it, is terminated by its pid), and (None, message) when
     it died without answering (a crash inside an engine).  An exception inside fn is
     fn's business: it should return it as data."""
-    ctx = multiprocessing.get_context("fork")
+    ctx = multiprocessing.get_context(start_method(multiprocessing.get_all_start_methods()))
     recv, send = ctx.Pipe(duplex=False)
-
-    def child() -> None:
-        send.send(fn())
-        send.close()
-
-    proc = ctx.Process(target=child, daemon=True)
+    proc = ctx.Process(target=_answer, args=(fn, send), daemon=True)
     proc.start()
     send.close()
     try:
@@ -117,6 +115,12 @@ def run_capped(
         return None, None
     finally:
         recv.close()
+
+
+def _answer(fn: Callable[[], Any], send) -> None:
+    """The child's work: fn's result through the pipe."""
+    send.send(fn())
+    send.close()
 
 
 TICK_S = 1.0

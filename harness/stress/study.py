@@ -36,6 +36,7 @@ runs in a forked child process) and reported the same way.
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 import time
@@ -137,6 +138,14 @@ def _skipped_row(
     }
 
 
+def _judged_run(engine, scene, step, t_end, ref) -> dict[str, Any]:
+    """One engine run of a case, judged (module level: a spawned child runs it)."""
+    traj, wall, err = timed(lambda: run_simulator(engine, scene, step, t_end))
+    if traj is None:
+        traj = Trajectory.failed(engine, scene.name, step, err or "")
+    return {**assess(traj, ref, scene, t_end, error=err), "wall_time_s": wall}
+
+
 def _engine_row(
     case: StressCase,
     engine: str,
@@ -166,12 +175,7 @@ def _engine_row(
         if predicted is not None and predicted > budget_s:
             return _skipped_row(case, engine, step, predicted, over_budget(predicted, budget_s))
 
-    def judged_run() -> dict[str, Any]:
-        traj, wall, err = timed(lambda: run_simulator(engine, scene, step, t_end))
-        if traj is None:
-            traj = Trajectory.failed(engine, scene.name, step, err or "")
-        return {**assess(traj, ref, scene, t_end, error=err), "wall_time_s": wall}
-
+    judged_run = functools.partial(_judged_run, engine, scene, step, t_end, ref)
     cap = HARD_CAP_FACTOR * budget_s
     guess = "not predicted" if predicted is None else f"predicted {predicted:.3g} s"
     bar.set_postfix_str(f"{case.name}: {engine}, {guess}, hard cap {cap:g} s", refresh=True)

@@ -17,12 +17,12 @@ from __future__ import annotations
 
 import os
 import signal
-import sys
 import threading
 import time
 from collections import deque
 from collections.abc import Iterator
 
+from ..child_processes import start_method
 from .grid import Chunk
 from .run import failed_rows, run_chunk
 
@@ -112,18 +112,6 @@ def _after_failure(work: _Work, exc: BaseException, queue: deque):
             queue.appendleft(_Work(Chunk(ch.config, ch.i_gamma, ch.i_rho, (s,))))
         return None
     return failed_rows(ch, f"worker failed: {type(exc).__name__}: {exc}")
-
-
-# runtimes that start thread pools at import: a process forked after one of them is
-# loaded may deadlock on a lock a thread of the parent held (JAX warns so at the fork)
-THREADED_RUNTIMES = ("jax",)
-
-
-def start_method(methods: list[str]) -> str:
-    """'fork' (workers share the compiled simulator) unless the platform lacks it or a
-    threaded runtime is loaded in this process (then 'spawn')."""
-    threaded = any(name in sys.modules for name in THREADED_RUNTIMES)
-    return "fork" if "fork" in methods and not threaded else "spawn"
 
 
 def run_local(
