@@ -27,8 +27,12 @@ def simulate(scene, *, dt=None, t_end=None):
 @pytest.fixture(autouse=True)
 def fork_children(monkeypatch):
     """The tests' monkeypatches reach a capped run's child by fork only (a spawned child
-    imports the modules afresh): fork even where another test has loaded JAX."""
+    imports the modules afresh): fork even where another test has loaded JAX (these
+    children run no JAX: its fork warning is expected here)."""
     monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
+
+
+pytestmark = pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")
 
 
 @pytest.fixture

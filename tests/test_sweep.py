@@ -208,6 +208,7 @@ def _boom_on_sample_1(config, rho, gamma, q0, p0):
     raise ValueError(f"boom at rho={rho}")
 
 
+@pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")  # forked on purpose, below
 def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
     import harness.child_processes as child_processes
     import harness.sweep.run as sr
