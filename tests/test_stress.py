@@ -9,6 +9,7 @@ import pytest
 
 from harness import child_processes
 from harness import stress as S
+from harness.stress import budget as stress_budget
 from harness.stress import cases as stress_cases
 from harness.stress import judge as stress_judge
 from harness.stress import study as stress_study
@@ -205,7 +206,7 @@ def test_run_past_the_hard_cap_is_stopped_and_reported(monkeypatch):
         time.sleep(30.0)
 
     monkeypatch.setattr(stress_study, "predict_engine_time", lambda *a: None)
-    monkeypatch.setattr(stress_study, "run_simulator", slow)
+    monkeypatch.setattr(stress_budget, "run_simulator", slow)
     start = time.perf_counter()
     doc = S.stress(engines=["mujoco"], cases=["grazing"], budget_s=0.3)
     assert time.perf_counter() - start < 10.0
@@ -217,6 +218,6 @@ def test_engine_process_dying_is_a_failed_run(monkeypatch):
     import os
 
     monkeypatch.setattr(stress_study, "predict_engine_time", lambda *a: None)
-    monkeypatch.setattr(stress_study, "run_simulator", lambda *a, **k: os._exit(3))
+    monkeypatch.setattr(stress_budget, "run_simulator", lambda *a, **k: os._exit(3))
     (row,) = S.stress(engines=["mujoco"], cases=["grazing"])["cases"]
     assert row["verdict"] == "failed" and "exit code 3" in row["reason"]

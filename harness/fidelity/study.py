@@ -41,10 +41,10 @@ from ..simulators import engine_names, is_fixed_step, run_simulator, warm_up
 from ..stress.budget import (
     HARD_CAP_FACTOR,
     PILOT_FREE_STEPS,
+    engine_run,
     over_budget,
     predict_engine_time,
     run_capped,
-    timed,
 )
 from .criteria import FidelityCriteria, alpha_star, exponent_check, impacts_pass, power_law_fit
 from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
@@ -295,9 +295,7 @@ def engine_row(
 
 def _scored_run(engine, scene, dt, t_run, case, criteria, band) -> dict[str, Any]:
     """One engine run at one scale, scored (module level: a spawned child runs it)."""
-    traj, wall, err = timed(lambda: run_simulator(engine, scene, dt, t_run))
-    if traj is None:
-        traj = Trajectory.failed(engine, scene.name, dt, err or "")
+    traj, wall, _ = engine_run(engine, scene, dt, t_run)
     compile_s = traj.stats.get("compile_time_s")  # inside wall (MJX's JIT)
     return {**score(traj, case, criteria, band), "wall_time_s": wall, "compile_time_s": compile_s}
 

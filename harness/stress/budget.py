@@ -34,6 +34,15 @@ def timed(fn: Callable[[], Trajectory]) -> tuple[Trajectory | None, float, str |
     return traj, time.perf_counter() - start, err
 
 
+def engine_run(engine: str, scene: Scene, dt: float | None, t_end: float):
+    """One run of a simulator, timed: (its trajectory, a `failed` one when it raised; the
+    wall time; the error, or None)."""
+    traj, wall, err = timed(lambda: run_simulator(engine, scene, dt, t_end))
+    if traj is None:
+        traj = Trajectory.failed(engine, scene.name, dt, err or "")
+    return traj, wall, err
+
+
 def run_reference(scene: Scene, budget_s: float) -> tuple[Trajectory | None, float, float, bool]:
     """The reference on a case within the budget: (trajectory, wall, predicted, skipped).
 

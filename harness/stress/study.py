@@ -53,15 +53,14 @@ from ..simulators import (
     check_run,
     engine_names,
     is_fixed_step,
-    run_simulator,
 )
 from .budget import (
     HARD_CAP_FACTOR,
+    engine_run,
     over_budget,
     predict_engine_time,
     run_capped,
     run_reference,
-    timed,
 )
 from .cases import StressCase, select_cases
 from .judge import FAILED_ENERGY_GAIN, FAILED_PENETRATION, TOLERANCES, assess
@@ -140,9 +139,7 @@ def _skipped_row(
 
 def _judged_run(engine, scene, step, t_end, ref) -> dict[str, Any]:
     """One engine run of a case, judged (module level: a spawned child runs it)."""
-    traj, wall, err = timed(lambda: run_simulator(engine, scene, step, t_end))
-    if traj is None:
-        traj = Trajectory.failed(engine, scene.name, step, err or "")
+    traj, wall, err = engine_run(engine, scene, step, t_end)
     return {**assess(traj, ref, scene, t_end, error=err), "wall_time_s": wall}
 
 
