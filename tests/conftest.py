@@ -80,6 +80,17 @@ def no_sweep_figures(monkeypatch):
 
 
 @pytest.fixture
+def fork_children(monkeypatch):
+    """Child processes fork even where another test has loaded JAX
+    (harness.child_processes): a test's monkeypatches reach a capped run's child by fork
+    only (a spawned child imports the modules afresh).  For tests whose children run no
+    JAX, so that JAX's fork warning is expected there."""
+    import harness.child_processes
+
+    monkeypatch.setattr(harness.child_processes, "THREADED_RUNTIMES", ())
+
+
+@pytest.fixture
 def scene_factory():
     return make_scene
 

@@ -9,7 +9,7 @@ import json
 
 import pytest
 
-from harness import child_processes, simulators
+from harness import simulators
 from harness.cli import main
 
 MESSAGE = "the raiser engine takes no scene"
@@ -23,16 +23,11 @@ def simulate(scene, *, dt=None, t_end=None):
     raise SceneError("{MESSAGE}")
 '''
 
-
-@pytest.fixture(autouse=True)
-def fork_children(monkeypatch):
-    """The tests' monkeypatches reach a capped run's child by fork only (a spawned child
-    imports the modules afresh): fork even where another test has loaded JAX (these
-    children run no JAX: its fork warning is expected here)."""
-    monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
-
-
-pytestmark = pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")
+# capped runs fork (tests/conftest.py: fork_children)
+pytestmark = [
+    pytest.mark.usefixtures("fork_children"),
+    pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"),
+]
 
 
 @pytest.fixture

@@ -7,7 +7,6 @@ import math
 import numpy as np
 import pytest
 
-from harness import child_processes
 from harness import stress as S
 from harness.stress import budget as stress_budget
 from harness.stress import cases as stress_cases
@@ -16,16 +15,11 @@ from harness.stress import study as stress_study
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
 from reference.trajectory import ImpactEvent, Status, Trajectory
 
-
-@pytest.fixture(autouse=True)
-def fork_children(monkeypatch):
-    """The tests' monkeypatches reach a capped run's child by fork only (a spawned child
-    imports the modules afresh): fork even where another test has loaded JAX (these
-    children run no JAX: its fork warning is expected here)."""
-    monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
-
-
-pytestmark = pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")
+# capped runs fork (tests/conftest.py: fork_children)
+pytestmark = [
+    pytest.mark.usefixtures("fork_children"),
+    pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"),
+]
 
 
 CONTRACT_ROW = {
