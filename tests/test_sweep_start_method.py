@@ -25,7 +25,7 @@ def test_the_pool_spawns_where_the_platform_cannot_fork(monkeypatch):
 
 def test_a_capped_run_is_spawned_once_jax_is_loaded_and_answers(monkeypatch):
     """With JAX loaded a capped engine run's child is spawned, not forked (a forked
-    child hung in `harness fidelity … --engine mjx`), and still returns its answer."""
+    child can hang: harness.child_processes), and still returns its answer."""
     monkeypatch.setitem(sys.modules, "jax", object())
     methods = []
     real = multiprocessing.get_context
