@@ -20,7 +20,7 @@ import numpy as np
 from . import compiled
 from .checks import check_reference_options, run_horizon
 from .core import records as R
-from .core.laws import LAW_PAPER, law_code, law_of, work_floats
+from .core.laws import LAW_PAPER, law_code, law_of, law_of_name, work_floats
 from .core.records import (
     N_ACCUMULATIONS,
     N_IMPACTS,
@@ -162,7 +162,7 @@ def model_record(scene: Scene) -> np.ndarray:
 def law_arrays(scene: Scene, opts: ReferenceOptions) -> tuple:
     """The scratch of a simultaneous impact under the scene's law (records.new_law_arrays)."""
     k = law_contacts(scene)
-    work = work_floats(law_of(law_code(scene.impact_law)), k)
+    work = work_floats(law_of_name(scene.impact_law), k)
     return R.new_law_arrays(k, opts.sequential_order or (), work)
 
 

@@ -4,8 +4,6 @@ reference.core.law_event), an activation (contacts landing at rest start to be h
 and the start of the run.  Each returns False when it ended the run (state.status
 set), True otherwise."""
 
-import numpy as np
-
 from .chatter import accumulation_time, completion_speed
 from .contacts import (
     contact_frame,
@@ -21,7 +19,7 @@ from .floor import below_floor
 from .held import held_acceleration, solve_lcp, zero_normal_velocities
 from .impact import bounce_ratio, impact, pushed_contacts
 from .inertia import excess_energy
-from .jit import ZERO, copy_into, hot, sort_prefix
+from .jit import ONE, ZERO, copy_into, hot, sort_prefix
 from .law_event import law_event
 from .laws import LAW_PAPER
 from .output import push_accumulation, push_impact, push_sample
@@ -83,7 +81,7 @@ def _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, res
     for i in range(n_rest):
         named[m] = resting[i]
         m += 1
-    return law_event(state, model, pts, opts, stats, out, ws, cs, named, np.int64(m))
+    return law_event(state, model, pts, opts, stats, out, ws, cs, named, m)
 
 
 @hot
@@ -113,8 +111,8 @@ def resolve_impact(state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, 
     if n_pushed > 0:
         copy_into(y, ws.y_start)
         if model.law != LAW_PAPER:
-            return _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting,
-                               np.int64(1), resting, n_rest)  # fmt: skip
+            return _law_impact(state, model, pts, opts, stats, out, ws, cs, hitting, ONE,
+                               resting, n_rest)  # fmt: skip
         state.info_contact = k
         end_run(state, STATUS_PUSHED, ws.before, n_pushed)
         return False
@@ -246,10 +244,9 @@ def resolve_touching(state, model, pts, opts, stats, out, ws, cs):
             resting[n_rest] = k
             n_rest += 1
     if n_hit:
-        return resolve_impact(  # the counts as int64, not literals (jit.py)
-            state, model, pts, opts, stats, out, ws, cs, hitting, np.int64(n_hit), resting,
-            np.int64(n_rest),
-        )  # fmt: skip
+        return resolve_impact(
+            state, model, pts, opts, stats, out, ws, cs, hitting, n_hit, resting, n_rest
+        )
     if n_rest >= model.all_down:
         end_run(state, STATUS_AT_REST, resting, n_rest)
         state.t_singularity = state.t_hi  # at rest from the start: the motion ended there

@@ -16,15 +16,14 @@ default): the loop ends a run whose state is not finite with an explicit status
 (STATUS_FAILED_NONFINITE), and the tests cost ~2 % of a run's instructions (callgrind,
 five bench runs; results bit-identical on 17 check scenes).
 One signature per event function: numba compiles a function once per tuple of argument
-types, types a constant argument as its value (`Literal[int](0)`) and a record's array
-field as a nested array of its length, and every signature compiles the function and
-everything it calls again.  The calls of the impact events (`events.resolve_impact`,
-its law path) therefore pass counts as `np.int64(k)` and a record's contact list as a
-view (`state.active[:]`): the law's chain is compiled once, not once per call site.
-Everywhere else on the event path a constant argument is one of the typed constants
-below, a counter passed on starts at `ZERO` (numba's type inference first types
-`m = 0` as `Literal[int](0)` and resolves the calls with that type too), an optional
-argument is passed, and a record's arrays of one role share one shape.  The build
+types, types a constant argument as its value (`Literal[int](0)`), an omitted optional
+argument as a type of its own and a record's array field as a nested array of its
+length, and every signature compiles the function and everything it calls again.  On
+the event path a constant argument is therefore one of the typed constants below, a
+counter passed on starts at `ZERO` (numba's type inference first types `m = 0` as
+`Literal[int](0)` and resolves the calls with that type too), every argument is passed,
+a record's contact list is passed as a view (`state.active[:]`), and a record's arrays
+of one role share one shape.  The build
 (`python -m reference.core.aot`) lists the functions still compiled more than once:
 `search.examine` and the frame functions under it, specialised on the contact kind on
 purpose (docs/performance.md, "Event search"), and small helpers that the exported
@@ -37,6 +36,7 @@ from numba import njit
 # Typed constants for calls on the event path: typed as int64 and bool, as the variables
 # at the other call sites are (a literal `0` or `True` is typed as its value).
 ZERO = np.int64(0)
+ONE = np.int64(1)
 FALSE = np.bool_(False)
 TRUE = np.bool_(True)
 

@@ -75,11 +75,8 @@ def law_names(laws=LAWS):
 
 
 def law_code(name, laws=LAWS):
-    """The integer code of the law called `name` (KeyError if there is none)."""
-    for law in laws:
-        if law.name == name:
-            return law.code
-    raise KeyError(name)
+    """The integer code of the law called `name` (ValueError if there is none)."""
+    return law_of_name(name, laws).code
 
 
 def law_help(laws=LAWS):

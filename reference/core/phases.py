@@ -155,7 +155,7 @@ def flight_step(state, model, pts, opts, stats, out, ws, cs):
         return DONE
     resolve_impact(  # no contact held in flight; one signature of resolve_impact (jit.py)
         state, model, pts, opts, stats, out, ws, cs, cs.together, ev.n_together,
-        state.active[:], np.int64(0),
+        state.active[:], ZERO,
     )  # fmt: skip
     return DONE
 
