@@ -134,14 +134,16 @@ def differences(x: dict, y: dict) -> tuple[list[str], float]:
     return said, worst
 
 
-def compare(a: str, b: str) -> None:
+def compare(a: str, b: str) -> int:
+    """Print each run's differences; returns 1 when a run differs or is missing, else 0."""
     A, B = pickle.loads(Path(a).read_bytes()), pickle.loads(Path(b).read_bytes())
-    runs = same = arrays = values = 0
+    runs = same = arrays = values = failed = 0
     worst = 0.0
     for key, x in A.items():
         y = B.get(key)
         if y is None or "error" in x or "error" in y:
             if x != y:
+                failed += 1
                 print(f"{key:44s} {x.get('error')} -> {y and y.get('error')}")
             continue
         runs += 1
@@ -153,13 +155,14 @@ def compare(a: str, b: str) -> None:
         print(f"{key:44s} {'same' if not said else ' '.join(said)}")
     print(f"{same} of {runs} runs bit-identical ({arrays} arrays, {values} values); "
           f"largest relative difference {worst:.3g}")  # fmt: skip
+    return int(failed > 0 or same < runs)
 
 
 if __name__ == "__main__":
     if len(sys.argv) >= 3 and sys.argv[1] == "dump":
         dump(sys.argv[2], (sys.argv[3] if len(sys.argv) > 3 else "paper").split(","))
     elif len(sys.argv) == 4 and sys.argv[1] == "compare":
-        compare(sys.argv[2], sys.argv[3])
+        sys.exit(compare(sys.argv[2], sys.argv[3]))
     else:
         print(__doc__)
         sys.exit(2)

@@ -250,6 +250,37 @@ def _closed_indices(closed, idx, limit):
     return n
 
 
+@_helper
+def _one_held(F, tinv, g, i0, acc):
+    """The force η = g/w₀₀ of contact i0 held alone and the acceleration Θ⁻¹f₀η − g u₃
+    into acc (the paper, section 2.5, eq. pacccontact); returns η."""
+    e = g / _w(F, tinv, i0, i0)
+    for i in range(3):
+        acc[i] = tinv[i] * F[i0, i] * e
+    acc[2] -= g
+    return e
+
+
+@_helper
+def _two_held_forces(F, tinv, g, i0, i1):
+    """The forces (η₀, η₁) of contacts i0 and i1 held together, F_BΘ⁻¹F_Bᵀη = g 1;
+    (nan, nan) when the pair is singular."""
+    a00, a01, a11 = _w(F, tinv, i0, i0), _w(F, tinv, i0, i1), _w(F, tinv, i1, i1)
+    det = a00 * a11 - a01 * a01
+    if det == 0.0:
+        return math.nan, math.nan
+    return g * (a11 - a01) / det, g * (a00 - a01) / det
+
+
+@_helper
+def _two_held(F, tinv, g, i0, i1, e0, e1, acc):
+    """The acceleration Θ⁻¹(f₀η₀ + f₁η₁) − g u₃ of contacts i0, i1 held with forces
+    e0, e1 into acc."""
+    for i in range(3):
+        acc[i] = tinv[i] * (F[i0, i] * e0 + F[i1, i] * e1)
+    acc[2] -= g
+
+
 @njit(cache=True)
 def _held_solve(F, tinv, g, closed_idx, m, acc, held):
     """Admissible held subset B of the closed contacts (m ≤ 2): the LCP
@@ -262,34 +293,21 @@ def _held_solve(F, tinv, g, closed_idx, m, acc, held):
     tol = 1e-12 * g
     if m == 2:
         i0, i1 = closed_idx[0], closed_idx[1]
-        a00, a01, a11 = _w(F, tinv, i0, i0), _w(F, tinv, i0, i1), _w(F, tinv, i1, i1)
-        det = a00 * a11 - a01 * a01
-        if det != 0.0:
-            e0 = g * (a11 - a01) / det
-            e1 = g * (a00 - a01) / det
-            if e0 >= -tol and e1 >= -tol:
-                for i in range(3):
-                    acc[i] = tinv[i] * (F[i0, i] * e0 + F[i1, i] * e1)
-                acc[2] -= g
-                held[0] = i0
-                held[1] = i1
-                return 2
+        e0, e1 = _two_held_forces(F, tinv, g, i0, i1)
+        if e0 >= -tol and e1 >= -tol:  # (nan: singular)
+            _two_held(F, tinv, g, i0, i1, e0, e1, acc)
+            held[0] = i0
+            held[1] = i1
+            return 2
         for k in range(2):
             ih, io = closed_idx[k], closed_idx[1 - k]
-            e = g / _w(F, tinv, ih, ih)
-            for i in range(3):
-                acc[i] = tinv[i] * F[ih, i] * e
-            acc[2] -= g
+            e = _one_held(F, tinv, g, ih, acc)
             if e >= -tol and _dot(F, io, acc) >= -tol:
                 held[0] = ih
                 return 1
     elif m == 1:
         ih = closed_idx[0]
-        e = g / _w(F, tinv, ih, ih)
-        for i in range(3):
-            acc[i] = tinv[i] * F[ih, i] * e
-        acc[2] -= g
-        if e >= -tol:
+        if _one_held(F, tinv, g, ih, acc) >= -tol:
             held[0] = ih
             return 1
     for i in range(3):
@@ -490,10 +508,16 @@ def _resting(F, c, q, p, qs, ps, vfl):
 
 
 @_helper
+def _closing(F, c, p, ps, vfl):
+    """Contact c's normal velocity f_cᵀp below zero beyond roundoff."""
+    return _dot(F, c, p) < -_tol(F, c, ps, vfl)
+
+
+@_helper
 def _approaching(F, c, q, p, qs, ps, vfl):
     """Contact c touching and moving into the ground beyond roundoff: an impact now (the
     paper, section 2.3: u_Zᵀr_i = 0, u_Zᵀv_i < 0)."""
-    return _touching(F, c, q, qs) and _dot(F, c, p) < -_tol(F, c, ps, vfl)
+    return _touching(F, c, q, qs) and _closing(F, c, p, ps, vfl)
 
 
 @_helper
@@ -546,9 +570,15 @@ def _apply_impulse(F, tinv, w, gamma, j, q, p, q_pre, p_pre):
     for i in range(3):
         q_pre[i] = q[i]
         p_pre[i] = p[i]
-    for i in range(3):
-        p[i] += tinv[i] * F[j, i] * lam
+    _add_impulse(F, tinv, j, lam, p)
     return vpre, lam
+
+
+@_helper
+def _add_impulse(F, tinv, c, lam, p):
+    """p ← p + Θ⁻¹f_c λ: an impulse λ at contact c (eq. impactequ)."""
+    for i in range(3):
+        p[i] += tinv[i] * F[c, i] * lam
 
 
 @_helper
@@ -650,12 +680,23 @@ def _impact_step(model, limits, state, scratch, ring, out, si, sf, info, j, E, v
     if si[SI_STATUS] >= 0:
         return
     E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
+    if _energy_ended(si, info, E, log2_energy_floor):
+        return
+    if 0.0 < bounce_ratio(gamma) < 1.0 and not _any_closed(closed):
+        _complete_chatter(model, limits, state, scratch, ring, out, si, sf, info, j, E, vpre)
+
+
+@_helper
+def _energy_ended(si, info, E, log2_energy_floor):
+    """After an impact: stop the run, a singularity, when the energy E (in the scaled
+    units) is gone or below the floor; returns whether it stopped."""
     if not (E > 0.0):
         _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
-    elif math.log2(E) + 2 * si[SI_KV] <= log2_energy_floor:
+        return True
+    if math.log2(E) + 2 * si[SI_KV] <= log2_energy_floor:
         _stop(si, info, SINGULARITY, REASON_ENERGY_EXHAUSTED, -1, -1)
-    elif 0.0 < bounce_ratio(gamma) < 1.0 and not _any_closed(closed):
-        _complete_chatter(model, limits, state, scratch, ring, out, si, sf, info, j, E, vpre)
+        return True
+    return False
 
 
 # ------------------------------------------------------------------ chatter completion
@@ -1100,8 +1141,7 @@ def _law_failed(si, info, together, contacts, k, outcome, hits):
 def _any_approaching(F, p, ps, vfl, contacts, k):
     """Whether a contact of contacts[:k] approaches beyond roundoff."""
     for i in range(k):
-        c = contacts[i]
-        if _dot(F, c, p) < -_tol(F, c, ps, vfl):
+        if _closing(F, contacts[i], p, ps, vfl):
             return True
     return False
 
@@ -1139,9 +1179,7 @@ def _add_law_impulses(F, tinv, contacts, k, lam, p):
     """p ← p + Θ⁻¹F_SᵀΛ, contact by contact (as `_apply_impulse`)."""
     for i in range(k):
         if lam[i] != 0.0:
-            c = contacts[i]
-            for j in range(3):
-                p[j] += tinv[j] * F[c, j] * lam[i]
+            _add_impulse(F, tinv, contacts[i], lam[i], p)
 
 
 @_law_helper
@@ -1184,29 +1222,20 @@ def _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q, p_pre, p
 def _rest_acceleration(F, tinv, g, rest, m, acc):
     """The constant acceleration with the m ≤ 2 contacts rest[:m] held (F_B Θ⁻¹ F_Bᵀ η
     = g 1, ṗ = Θ⁻¹F_Bᵀη − g u3: the paper, section 2.5, eq. pacccontact) into acc;
-    False when a force η comes out negative (or the set is singular)."""
+    False when a force η comes out negative (or the set is singular).  Unlike
+    `_held_solve` every contact must be held, with no roundoff allowance: the series
+    rests on all of them."""
+    if m == 1:
+        return _one_held(F, tinv, g, rest[0], acc) >= 0.0
+    if m == 2:
+        e0, e1 = _two_held_forces(F, tinv, g, rest[0], rest[1])
+        if not (e0 >= 0.0 and e1 >= 0.0):  # (nan: singular)
+            return False
+        _two_held(F, tinv, g, rest[0], rest[1], e0, e1, acc)
+        return True
     for i in range(3):
         acc[i] = 0.0
-    if m == 1:
-        i0 = rest[0]
-        e = g / _w(F, tinv, i0, i0)
-        if e < 0.0:
-            return False
-        for i in range(3):
-            acc[i] = tinv[i] * F[i0, i] * e
-    elif m == 2:
-        i0, i1 = rest[0], rest[1]
-        a00, a01, a11 = _w(F, tinv, i0, i0), _w(F, tinv, i0, i1), _w(F, tinv, i1, i1)
-        det = a00 * a11 - a01 * a01
-        if det == 0.0:
-            return False
-        e0 = g * (a11 - a01) / det
-        e1 = g * (a00 - a01) / det
-        if e0 < 0.0 or e1 < 0.0:
-            return False
-        for i in range(3):
-            acc[i] = tinv[i] * (F[i0, i] * e0 + F[i1, i] * e1)
-    acc[2] -= g
+    acc[2] = -g
     return True
 
 
@@ -1392,11 +1421,7 @@ def _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contact
     E_post = _energy(q, p, thd, mass, sf[SF_GRAVITY])
     _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q_pre, p_pre, p)
     info[INFO_LAW_IMPACTS] += 1
-    if not (E_post > 0.0):
-        _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
-        return False
-    if math.log2(E_post) + 2 * si[SI_KV] <= log2_floor:
-        _stop(si, info, SINGULARITY, REASON_ENERGY_EXHAUSTED, -1, -1)
+    if _energy_ended(si, info, E_post, log2_floor):
         return False
     return not _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws,
                               contacts, k, vfl)  # fmt: skip
@@ -1414,20 +1439,15 @@ def _go_on(model, state, out, si, sf, info):
     if not (E > 0.0):
         _stop(si, info, SINGULARITY, REASON_NO_ENERGY, -1, -1)
         return
-    _renormalise(F, q, p, qs, ps, E, si, sf, 1)
+    E = _normalise_at(model, state, si, sf, E)
     for i in range(3):
-        qs[i] = abs(q[i])
-        ps[i] = abs(p[i])
-        acc[i] = 0.0
         held[i] = -1
-    acc[2] = -sf[SF_GRAVITY]
     _record_held_set(out, si[SI_EVENTS] - 1, held, acc)
     for c in range(F.shape[0]):
         closed[c] = False
     si[SI_RB_POS] = 0
     si[SI_RB_N] = 0
     sf[SF_DT_PENDING] = 0.0
-    E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
     _close_resting_contacts(F, q, p, qs, ps, closed, _velocity_scale(E, wmax))
 
 
@@ -1492,17 +1512,28 @@ def _step(model, limits, state, scratch, ring, out, si, sf, info):
 
 
 @_helper
-def _start(model, state, out, si, sf, E):
-    """Normalise the initial state of energy E > 0 (module docstring, Scaling), write the
-    INITIAL row and close the contacts resting at t = 0."""
+def _normalise_at(model, state, si, sf, E):
+    """The scales renormalised at the state (q, p) of energy E > 0 (module docstring,
+    Scaling), qs and ps its magnitudes, acc free flight's; returns the energy in the new
+    scales."""
     F, thd, tinv, w, wmax, mass, gamma, rank_f = model
     q, p, qs, ps, acc, held, closed = state
     _renormalise(F, q, p, qs, ps, E, si, sf, 1)
     for i in range(3):
         qs[i] = abs(q[i])
         ps[i] = abs(p[i])
+        acc[i] = 0.0
     acc[2] = -sf[SF_GRAVITY]
-    E = _energy(q, p, thd, mass, sf[SF_GRAVITY])
+    return _energy(q, p, thd, mass, sf[SF_GRAVITY])
+
+
+@_helper
+def _start(model, state, out, si, sf, E):
+    """Normalise the initial state of energy E > 0 (module docstring, Scaling), write the
+    INITIAL row and close the contacts resting at t = 0."""
+    F, thd, tinv, w, wmax, mass, gamma, rank_f = model
+    q, p, qs, ps, acc, held, closed = state
+    E = _normalise_at(model, state, si, sf, E)
     _write_state_row(out, 0, INITIAL, si, held, 0.0, 0.0, 0.0, E, q, p, acc)
     si[SI_EVENTS] = 1
     _close_resting_contacts(F, q, p, qs, ps, closed, _velocity_scale(E, wmax))
