@@ -143,10 +143,12 @@ def run_chunk(precision: str, steps: int, batched: bool, mx, dx):
     compiled scan of CHUNK_STEPS steps: (the data at the scan's end, past the steps
     when steps < CHUNK_STEPS; (qpos, qvel, forces) of the steps, step axis 0 (1 after
     the batch's); the seconds spent compiling now).  JAX compiles a program per scan
-    length (4–11 s each on this CPU): with one length, runs of every length (a run's
+    length (docs/engines.md, "MJX"): with one length, runs of every length (a run's
     last chunk, fidelity's scales and pilot runs) share one program; a shorter chunk
-    computes the steps past it and drops them (at most CHUNK_STEPS − 1: 0.1 s at 58 µs
-    a step here; their time counts in the run's wall time)."""
+    computes the steps past it and drops them (their time counts in the run's wall
+    time)."""
+    if not 0 < steps <= CHUNK_STEPS:
+        raise ValueError(f"a chunk is 1 to {CHUNK_STEPS} steps, not {steps}")
     fn, seconds = compiled_scan(precision, CHUNK_STEPS, batched, mx, dx)
     dx_end, out = fn(mx, dx)
     if steps < CHUNK_STEPS:

@@ -2,10 +2,9 @@
 hard cap): by fork, so that the child shares the parent's imports and compiled code,
 unless the platform cannot fork or a runtime that starts threads at import is loaded in
 this process.  A process forked then may deadlock on a lock that one of the parent's
-threads held at the fork (JAX warns so at the fork; `harness fidelity pentagon-bounce
---engine mjx --dt 1e-4`, whose short runs load JAX in the parent, hangs so in the first
-run of a forked child until the hard cap stops it).  Such a child is spawned instead: it
-imports and compiles what it needs itself, and what it runs must be picklable."""
+threads held at the fork (JAX warns so at the fork; docs/engines.md, "MJX", has the
+measured case).  Such a child is spawned instead: it imports and compiles what it needs
+itself, and what it runs must be picklable."""
 
 from __future__ import annotations
 

@@ -21,6 +21,8 @@ import time
 from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
+from .text import WIDTH
+
 if TYPE_CHECKING:
     from tqdm import tqdm
 
@@ -76,7 +78,6 @@ def progress_bar(
 BAR_FORMAT = (
     "{desc}: {percentage:3.0f}%|{bar:20}| {n_fmt}/{total_fmt} [{elapsed}<{remaining}]{postfix}"
 )
-WIDTH = 100
 
 
 def bar_columns() -> int:

@@ -57,13 +57,40 @@ def format_simulate(
     return "\n".join(lines)
 
 
+def quantile_cells(q: list[float] | None) -> list[str]:
+    """[10 %, 90 %] of [10 %, 50 %, 90 %] quantiles of matched counts as two cells
+    ('-', '-' without them)."""
+    if not q:
+        return ["-", "-"]
+    return [f"{q[0]:.0f}", f"{q[2]:.0f}"]
+
+
+def run_label(engine: str, dt: float | None) -> str:
+    """'mujoco 1e-03' for a fixed-step run, the engine's name for an event-driven one:
+    how every command names a run."""
+    return engine if dt is None else f"{engine} {dt:.0e}"
+
+
+def column_widths(rows: list[list[str]], header: list[str]) -> list[int]:
+    """Each column's width in `table`: its longest cell or its header."""
+    return [max([len(h), *(len(r[i]) for r in rows)]) for i, h in enumerate(header)]
+
+
+def fit_table(rows: list[list[str]], header: list[str], align: str, width: int = WIDTH) -> str:
+    """`table`, with the first column's long cells broken over lines of their own
+    (`wrap_first_column`) when the table would be wider than `width`: a long name."""
+    text = table(rows, header, align)
+    if max(len(line) for line in text.splitlines()) <= width:
+        return text
+    return table(wrap_first_column(rows, header, width), header, align)
+
+
 def wrap_first_column(rows: list[list[str]], header: list[str], width: int) -> list[list[str]]:
     """rows with each first cell longer than the room `width` leaves it (the other
     columns at their widths, two spaces apart) broken over lines of its own, the row's
     other cells on its first line: a long name keeps a table within `width` columns."""
-    others = sum(max(len(h), *(len(r[i]) for r in rows)) + 2 for i, h in enumerate(header))
-    others -= max(len(header[0]), *(len(r[0]) for r in rows)) + 2
-    room = max(width - others - 2, len(header[0]), 8)
+    others = sum(w + 2 for w in column_widths(rows, header)[1:])
+    room = max(width - others, len(header[0]), 8)
     out = []
     for row in rows:
         pieces = textwrap.wrap(row[0], room) or [""]  # at spaces and hyphens, else cut
@@ -82,11 +109,11 @@ def column_tables(
     """Tables of the rows `fixed` (header `head`, aligned by `align`) beside the named
     `columns` (name, one cell a row; right-aligned), as many tables as needed for each
     to fit `width` columns, each repeating the fixed columns."""
-    used = sum(max(len(h), *(len(r[i]) for r in fixed)) + 2 for i, h in enumerate(head))
+    used = sum(w + 2 for w in column_widths(fixed, head))
     chunks: list[list[tuple[str, list[str]]]] = [[]]
     room = used
     for name, cells in columns:
-        w = max(len(name), *(len(c) for c in cells)) + 2
+        w = column_widths([[c] for c in cells], [name])[0] + 2
         if chunks[-1] and room + w > width + 2:
             chunks.append([])
             room = used

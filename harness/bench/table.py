@@ -10,9 +10,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from ..metrics.follows import LEADING_IMPACTS, MATCH_FRACTION
-from ..text import table
+from ..text import WIDTH, table
 
-WIDTH = 100
 # Status names shortened in the default table (the JSON and --wide keep them whole).
 SHORT_STATUS = {"simultaneous_impact": "simultaneous"}
 

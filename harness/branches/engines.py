@@ -44,6 +44,7 @@ from reference.core import layout as L
 from reference.scene import velocity_unit
 
 from ..horizon.state import flown, scene_at
+from ..text import run_label
 from .follow import FOLLOW_FACTOR
 from .spread import ordered_runs
 
@@ -281,7 +282,7 @@ def planned_runs(engines: list[str], dts: list[float | None]) -> int:
 
 
 def study(scene, engines: list[str], dts: list[float | None], t_end: float | None = None,
-          progress=None, bar=None) -> ImpactStudy:  # fmt: skip
+          bar=None) -> ImpactStudy:  # fmt: skip
     """Every engine at every dt against every branch (module docstring).  `bar`: a
     harness.progress bar, advanced once per engine run (by all of them at once when the
     scene has no undecidable state)."""
@@ -304,11 +305,8 @@ def study(scene, engines: list[str], dts: list[float | None], t_end: float | Non
     runs = []
     for engine in engines:
         for dt in _engine_dts(engine, dts):
-            if progress:
-                progress(f"branches: {engine} dt={dt}")
             if bar is not None:
-                now = engine if dt is None else f"{engine} dt={dt:g}"
-                bar.set_postfix_str(f"{scene.name}: {now}", refresh=False)
+                bar.set_postfix_str(f"{scene.name}: {run_label(engine, dt)}", refresh=False)
             if dt not in starts:
                 starts[dt] = engine_start(scene, t_u, y_u, y0, lead, after, dt, contacts)
             y_dt, outcomes_dt = starts[dt] if starts[dt][1] is not None else (y0, outcomes)

@@ -8,6 +8,15 @@ import os
 
 import numpy as np
 
+# every law its colour, line style and marker in every panel
+LAWS_STYLE = {
+    "moreau": {"color": "C0", "ls": "-", "marker": "o"},
+    "sequential": {"color": "C1", "ls": "--", "marker": "s"},
+    "compliant": {"color": "C2", "ls": "-.", "marker": "^"},
+    "compliant-mass": {"color": "C3", "ls": ":", "marker": "v"},
+}
+LINESTYLES = ("-", "--", "-.", ":")
+
 
 def same_curves(spread) -> list[tuple[list[str], object]]:
     """The branches grouped by energy curves that are the same to roundoff, in their
@@ -45,10 +54,9 @@ def plot_spread(spread, path: str | os.PathLike) -> str:
 
     fig, (whole, after) = plt.subplots(1, 2, figsize=(13, 5.6))
     t_u = spread.undecidable["t"] if spread.undecidable is not None else None
-    statuses = {b.name: b.status for b in [spread.paper, *spread.branches]}
     for i, (names, b) in enumerate(same_curves(spread)):
         t, e = b.energy_curve
-        label = " = ".join(names) + f": {statuses[b.name]}"
+        label = " = ".join(names) + f": {b.status}"
         style = (
             {"lw": 2.5, "color": "k", "zorder": 5}
             if b.name == "paper"
@@ -75,16 +83,6 @@ def plot_spread(spread, path: str | os.PathLike) -> str:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return str(path)
-
-
-# every law its colour, line style and marker in every panel
-LAWS_STYLE = {
-    "moreau": {"color": "C0", "ls": "-", "marker": "o"},
-    "sequential": {"color": "C1", "ls": "--", "marker": "s"},
-    "compliant": {"color": "C2", "ls": "-.", "marker": "^"},
-    "compliant-mass": {"color": "C3", "ls": ":", "marker": "v"},
-}
-LINESTYLES = ("-", "--", "-.", ":")
 
 
 def plot_engines(studies, path: str | os.PathLike) -> str:

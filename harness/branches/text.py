@@ -5,9 +5,7 @@ from __future__ import annotations
 
 import textwrap
 
-from ..text import column_tables, num, table
-
-WIDTH = 100  # the terminal text fits this many columns
+from ..text import WIDTH, column_tables, num, run_label, table
 
 
 def format_spread(spread, label=str) -> str:
@@ -41,11 +39,6 @@ def format_spread(spread, label=str) -> str:
     )
     lines += textwrap.wrap(legend, WIDTH)
     return "\n".join(lines)
-
-
-def run_label(engine: str, dt: float | None) -> str:
-    """'mujoco 1e-03', 'linear': a run, as `harness compare` names runs."""
-    return engine if dt is None else f"{engine} {dt:.0e}"
 
 
 def format_study(study, label=str) -> str:

@@ -109,7 +109,7 @@ def run_engines(args) -> int:
         check_writable(args.plot, args.force, inputs, what="--plot", suffixes=(".png",))
     total = len(scenes) * planned_runs(args.engine, dts)
     with progress_bar(total, "branches", unit="run") as bar:
-        studies = [study(s, args.engine, dts, args.t_end, progress=log, bar=bar) for s in scenes]
+        studies = [study(s, args.engine, dts, args.t_end, bar=bar) for s in scenes]
     doc = attach({"command": "branches", "mode": "engines",
                   "studies": [s.to_dict() for s in studies]}, args)  # fmt: skip
     if args.plot:

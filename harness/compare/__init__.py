@@ -38,6 +38,7 @@ from ..horizon.verdict import Horizon, engine_horizon, planned_members, scene_ho
 from ..metrics import RunMetrics, effective_restitution, evaluate, run_exponent
 from ..progress import progress_bar
 from ..simulators import DEFAULT_DT, is_fixed_step, run_simulator, warm_up
+from ..text import run_label
 
 
 @dataclass
@@ -56,7 +57,7 @@ class EngineRun:
     @property
     def label(self) -> str:
         """'mujoco 1e-04' for fixed-step runs, the engine name otherwise."""
-        return self.engine if self.dt is None else f"{self.engine} {self.dt:.0e}"
+        return run_label(self.engine, self.dt)
 
     def to_dict(self) -> dict[str, Any]:
         traj = self.trajectory
@@ -163,7 +164,7 @@ def compare(
         say(_progress_line("reference", None, reference, ref_wall))
         bar.update()
         for engine, dt in plan:
-            bar.set_postfix_str(engine if dt is None else f"{engine} dt={dt:g}", refresh=False)
+            bar.set_postfix_str(run_label(engine, dt), refresh=False)
             if engine == "reference":
                 traj, wall = reference, ref_wall
             else:
@@ -258,7 +259,7 @@ def _timed_run(
 
 
 def _progress_line(engine: str, dt: float | None, traj: Trajectory, wall: float) -> str:
-    label = engine if dt is None else f"{engine} dt={dt:g}"
+    label = run_label(engine, dt)
     text = f"compare: {label}: {traj.status.value}, {len(traj.impacts)} impacts, "
     text += f"t_final={traj.t_final:.6g} ({wall:.2f} s)"
     if traj.status.value in ("failed", "stalled") and traj.message:

@@ -9,12 +9,11 @@ import textwrap
 from typing import TYPE_CHECKING
 
 from ..branches.follow import FOLLOW_FACTOR, BranchFollow
-from ..text import num, table
+from ..text import WIDTH, num, table
 
 if TYPE_CHECKING:
     from . import CompareResult, EngineRun
 
-WIDTH = 100
 LEFT = "left the reference before t_u: no branch"
 
 

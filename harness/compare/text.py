@@ -12,13 +12,11 @@ from reference.scene import Scene
 from reference.trajectory import Status
 
 from ..metrics import RELATIVE_TIME_TOLERANCE, STEPS_TIME_TOLERANCE
-from ..text import column_tables, impact_law_text, table, wrap_first_column
+from ..text import WIDTH, column_tables, fit_table, impact_law_text, num, quantile_cells, table
 from .branch_text import branch_lines, branch_sentence
 
 if TYPE_CHECKING:
     from . import CompareResult, EngineRun
-
-WIDTH = 100
 
 
 # ----------------------------------------------------------------------------- numbers
@@ -59,25 +57,13 @@ def _count_range(q: list[float]) -> str:
     return lo if lo == hi else f"{lo}–{hi}"
 
 
-def quantile_cells(q: list[float] | None) -> list[str]:
-    """[10 %, 90 %] of [10 %, 50 %, 90 %] quantiles of matched counts as two cells
-    ('-', '-' without them)."""
-    if q is None:
-        return ["-", "-"]
-    return [f"{q[0]:.0f}", f"{q[2]:.0f}"]
-
-
-def within_cell(within: bool | None) -> str:
-    return "-" if within is None else ("yes" if within else "no")
-
-
 def _horizon_wide(run: EngineRun) -> list[str]:
     """The wide table's horizon cells: the grid model's 10 % and 90 % matched, within,
     the run's own error, the perturbed model's 10 % and 90 % matched."""
     h = run.horizon
     if h is None:
         return ["-"] * 6
-    return [*quantile_cells(h.matched_quantiles), within_cell(h.within), _num(h.own_error),
+    return [*quantile_cells(h.matched_quantiles), num(h.within), _num(h.own_error),
             *quantile_cells(h.own_error_quantiles)]  # fmt: skip
 
 
@@ -239,7 +225,7 @@ def _verdict_table(result: CompareResult) -> str:
     drop = {2} if all(r[2] == "0" for r in rows) else set()
     drop |= {7, 8} if all(r[7] == "-" for r in rows) else set()
     drop |= {3} if len(_reference_counts(result)) == 1 else set()
-    # when the table is wider than WIDTH (long engine names beside an exponent): the wall
+    # wider than WIDTH with the simulators' names broken over lines (fit_table): the wall
     # time left out, then the exponent, each with a note (--wide has every column)
     attempts = (
         (set(), ""),
@@ -248,18 +234,15 @@ def _verdict_table(result: CompareResult) -> str:
     )
     for extra, note in attempts:
         keep = [i for i in range(len(header)) if i not in drop | extra]
-        text = table(
+        text = fit_table(
             [[r[i] for i in keep] for r in rows],
             [header[i] for i in keep],
-            align="".join(align[i] for i in keep),
+            "".join(align[i] for i in keep),
+            WIDTH,
         )
         if max(len(line) for line in text.splitlines()) <= WIDTH:
             return text + note
-    # still wider: the simulators' names broken over lines
-    kept = [[r[i] for i in keep] for r in rows]
-    labels = [header[i] for i in keep]
-    wrapped = wrap_first_column(kept, labels, WIDTH)
-    return table(wrapped, labels, align="".join(align[i] for i in keep)) + note
+    return text + note
 
 
 def _table_intro(result: CompareResult) -> str:
@@ -279,9 +262,7 @@ def _horizon_table(result: CompareResult) -> list[str]:
         if h is None:
             continue
         runs = max(runs, h.runs)
-        rows.append([run.label, str(h.matched), *quantile_cells(h.matched_quantiles),
-                     within_cell(h.within), _num(h.own_error),
-                     *quantile_cells(h.own_error_quantiles)])  # fmt: skip
+        rows.append([run.label, str(h.matched), *_horizon_wide(run)])
     if not rows:
         return []
     header = ["simulator", "matched", "grid 10 %", "grid 90 %", "within", "own error",

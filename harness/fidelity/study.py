@@ -11,7 +11,8 @@ Budget (the rules of `harness stress` and `harness bench`, by calling their func
 each fixed-step run's wall time is predicted (`predict_run_time`: pilot runs for long
 ones, and an extrapolation from the same engine and dt at the smaller scales already
 run) and the run is skipped when the prediction exceeds the per-run budget; a run of
-more than PILOT_FREE_STEPS steps runs in a forked child stopped at HARD_CAP_FACTOR × the
+more than PILOT_FREE_STEPS steps runs in a child process (harness.child_processes)
+stopped at HARD_CAP_FACTOR × the
 budget (predictions can miss costly later phases).  Once a scale is skipped or
 stopped, the larger scales of that engine and dt are skipped too: they cover the same
 motion with more steps.
@@ -46,6 +47,7 @@ from ..stress.budget import (
     predict_engine_time,
     run_capped,
 )
+from ..text import run_label
 from .criteria import FidelityCriteria, alpha_star, exponent_check, impacts_pass, power_law_fit
 from .leading import LeadingImpacts, inclination_scale, leading_impacts, run_end
 from .settings import DEFAULT_BUDGET_S, DEFAULT_DTS, DEFAULT_EPS_GRID, WINDOWS
@@ -410,7 +412,7 @@ def _engine_scales(engine, dt, cases, criteria, window, budget_s, bar, say, band
     `bands`: the horizon band per ε."""
     rows, blocked, measured = [], None, []
     for case in sorted(cases, key=lambda c: c.eps):
-        label = engine if dt is None else f"{engine} dt={dt:g}"
+        label = run_label(engine, dt)
         bar.set_postfix_str(f"{label} eps={case.eps:.3g}", refresh=False)
         band = bands.get(case.eps)
         row = engine_row(engine, dt, case, criteria, window, budget_s, measured, blocked, band)

@@ -7,9 +7,7 @@ import math
 import textwrap
 from typing import Any
 
-from ..text import column_tables, num, table
-
-WIDTH = 100
+from ..text import WIDTH, column_tables, num, run_label, table
 
 
 def alpha_star_text(star: dict[str, Any]) -> str:
@@ -165,11 +163,6 @@ def matched_cell(row: dict[str, Any] | None) -> str:
     if row is None or row["passes"] is None and not row["skipped"]:
         return "-"
     return "skipped" if row["skipped"] else str(row["leading_matched"])
-
-
-def run_label(engine: str, dt: float | None) -> str:
-    """'mujoco 1e-03', 'linear': a run's column, as `harness compare` names runs."""
-    return engine if dt is None else f"{engine} {dt:.0e}"
 
 
 def _ladder(doc: dict[str, Any]) -> str:

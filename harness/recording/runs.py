@@ -15,6 +15,7 @@ from reference.scene import Scene
 from reference.trajectory import Trajectory
 
 from ..metrics import ImpactMatch, RunMetrics, evaluate, run_exponent
+from ..text import run_label
 from .geometry import headings, inclinations
 
 # One colour per simulator in every view: the reference mid grey (context, never on top
@@ -85,11 +86,6 @@ def entity_names(trajs: list[Trajectory]) -> list[str]:
             name, k = f"{base}_{k}", k + 1
         names.append(name)
     return names
-
-
-def run_label(traj: Trajectory) -> str:
-    """'mujoco 1e-04' for fixed-step runs, the engine name otherwise (as `compare`)."""
-    return traj.engine if traj.dt is None else f"{traj.engine} {traj.dt:.0e}"
 
 
 def reference_end(reference: Trajectory) -> float:
@@ -165,7 +161,7 @@ def build_runs(
         runs.append(
             RunView(
                 name=name,
-                label=run_label(traj),
+                label=run_label(traj.engine, traj.dt),
                 color=REFERENCE_COLOR if k == 0 else PALETTE[(k - 1) % len(PALETTE)],
                 trajectory=shown,
                 is_reference=k == 0,

@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from ..text import quantile_cells
 from .html import Cell, details, esc, figure, num, paragraph, table
 from .links import file_href, url_scheme
 
@@ -140,11 +141,6 @@ def _branch_paragraphs(doc: dict[str, Any]) -> list[str]:
     return [f"<h3>{head}</h3>", *[paragraph(s) for s in sentences]]
 
 
-def _quantiles(q: list[float] | None) -> list[str]:
-    """The 10 % and 90 % quantiles of matched counts, a cell each."""
-    return ["-", "-"] if not q else [f"{q[0]:.0f}", f"{q[2]:.0f}"]
-
-
 def _horizon_cells(h: dict[str, Any] | None) -> list[Any]:
     """The grid model's 10 % and 90 % matched, within (its verdict as the cell's class),
     own error, the perturbed model's 10 % and 90 % matched."""
@@ -152,10 +148,10 @@ def _horizon_cells(h: dict[str, Any] | None) -> list[Any]:
         return ["-"] * 6
     within: Any = "-"
     if h.get("within") is not None:
-        word = "yes" if h["within"] else "no"
-        within = Cell(word, "pass" if h["within"] else "fail", "within" if h["within"] else "below")
-    return [*_quantiles(h.get("matched_quantiles")), within, num(h.get("own_error"), ".2e"),
-            *_quantiles(h.get("own_error_quantiles"))]  # fmt: skip
+        ok = h["within"]
+        within = Cell(num(ok), "pass" if ok else "fail", "within" if ok else "below")
+    return [*quantile_cells(h.get("matched_quantiles")), within, num(h.get("own_error"), ".2e"),
+            *quantile_cells(h.get("own_error_quantiles"))]  # fmt: skip
 
 
 def _horizon_paragraphs(doc: dict[str, Any]) -> str:

@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 import textwrap
 
+from ..text import WIDTH
 from .study import worst_row
 
-WIDTH = 100
 KEY = "{:<6} {:>6} {:>5}"  # geometry, dt, gamma
 CELL = 7
 EXTRAS_HEAD = f" {'dE/dEx-1':>9} {'gain':>4} {'pen/a':>7} {'t_c':>7}"

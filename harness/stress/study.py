@@ -31,7 +31,7 @@ impact), else `ok`; the reasons are listed.  A run whose predicted cost exceeds 
 per-run budget is not run: verdict `skipped (budget)` with the prediction (engines: two
 short pilot runs give the setup and per-step cost; the reference: a pilot over a tenth
 of the case); an engine or linear run still going at twice the budget is stopped (it
-runs in a forked child process) and reported the same way.
+runs in a child process: harness.child_processes) and reported the same way.
 """
 
 from __future__ import annotations

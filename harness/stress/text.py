@@ -11,12 +11,11 @@ from __future__ import annotations
 import textwrap
 from typing import Any
 
+from ..text import WIDTH, table
 from ..text import num as cell_text
-from ..text import table
 from .budget import HARD_CAP_FACTOR
 from .judge import FAILED_ENERGY_GAIN, FAILED_PENETRATION
 
-WIDTH = 100
 SHORT_VERDICT = {
     "ok": "ok",
     "degraded": "degraded",

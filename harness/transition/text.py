@@ -5,9 +5,7 @@ from __future__ import annotations
 import textwrap
 from typing import Any
 
-from ..text import table
-
-WIDTH = 100
+from ..text import WIDTH, table
 
 NAMES = {"rim_only": "rim only", "mixed": "mixed", "bumps_only": "bumps only"}
 
