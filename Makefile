@@ -112,4 +112,4 @@ browser:
 	@command -v chromium >/dev/null 2>&1 || { apt-get update && apt-get install -y chromium; }
 
 clean:
-	rm -rf $(VENV) .pytest_cache .ruff_cache build reference/core/_aot*
+	rm -rf $(VENV) .pytest_cache .ruff_cache .cache build reference/core/_aot*

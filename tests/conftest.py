@@ -82,12 +82,20 @@ def no_sweep_figures(monkeypatch):
 @pytest.fixture
 def fork_children(monkeypatch):
     """Child processes fork even where another test has loaded JAX
-    (harness.child_processes): a test's monkeypatches reach a capped run's child by fork
-    only (a spawned child imports the modules afresh).  For tests whose children run no
-    JAX, so that JAX's fork warning is expected there."""
+    (harness.child_processes): a test's monkeypatches reach a child (a sweep worker, a
+    capped run) by fork only, a spawned child imports the modules afresh.  For tests
+    whose children run no JAX: JAX's fork warning is expected there, and not shown
+    (`pytest_collection_modifyitems`)."""
     import harness.child_processes
 
     monkeypatch.setattr(harness.child_processes, "THREADED_RUNTIMES", ())
+
+
+def pytest_collection_modifyitems(items) -> None:
+    """The tests that fork on purpose (`fork_children`) do not show JAX's fork warning."""
+    for item in items:
+        if "fork_children" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"))
 
 
 @pytest.fixture

@@ -23,11 +23,7 @@ def simulate(scene, *, dt=None, t_end=None):
     raise SceneError("{MESSAGE}")
 '''
 
-# capped runs fork (tests/conftest.py: fork_children)
-pytestmark = [
-    pytest.mark.usefixtures("fork_children"),
-    pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"),
-]
+pytestmark = pytest.mark.usefixtures("fork_children")  # capped runs fork (conftest)
 
 
 @pytest.fixture

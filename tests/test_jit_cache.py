@@ -52,10 +52,10 @@ def test_a_changed_core_source_drops_the_linear_models_cache_too(sources, monkey
     assert cache_files(core) == [] and cache_files(linear) == []
 
 
-def test_a_changed_linear_source_drops_its_cache(sources, monkeypatch):
+def test_a_changed_linear_source_drops_both_caches(sources, monkeypatch):
     core, linear = sources
     check(monkeypatch)
-    fill(linear)
+    fill(core), fill(linear)
     (linear / "m.py").write_text("x = 2\n")
     check(monkeypatch)
-    assert cache_files(linear) == []
+    assert cache_files(core) == [] and cache_files(linear) == []

@@ -15,11 +15,7 @@ from harness.stress import study as stress_study
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
 from reference.trajectory import ImpactEvent, Status, Trajectory
 
-# capped runs fork (tests/conftest.py: fork_children)
-pytestmark = [
-    pytest.mark.usefixtures("fork_children"),
-    pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"),
-]
+pytestmark = pytest.mark.usefixtures("fork_children")  # capped runs fork (conftest)
 
 
 CONTRACT_ROW = {

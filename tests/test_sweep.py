@@ -208,9 +208,7 @@ def _boom_on_sample_1(config, rho, gamma, q0, p0):
     raise ValueError(f"boom at rho={rho}")
 
 
-@pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning")  # forked on purpose, below
-def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
-    import harness.child_processes as child_processes
+def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch, fork_children):
     import harness.sweep.run as sr
 
     real = sr.run_linear_sample
@@ -222,10 +220,7 @@ def test_a_run_that_raises_is_recorded_with_its_error(tmp_path, monkeypatch):
             return _boom_on_sample_1(config, rho, gamma, q0, p0)
         return real(config, rho, gamma, q0, p0)
 
-    monkeypatch.setattr(sr, "run_linear_sample", flaky)
-    # the patched function reaches the pool's workers by fork only (a spawned worker
-    # imports the module afresh): fork even where another test has loaded JAX
-    monkeypatch.setattr(child_processes, "THREADED_RUNTIMES", ())
+    monkeypatch.setattr(sr, "run_linear_sample", flaky)  # reaches the pool by fork only
     cfg = small_config(samples=2)
     doc = exponent_sweep(cfg, tmp_path, workers=1, figures=False, bar=False)
     df = rows(tmp_path)
