@@ -78,7 +78,7 @@ demo: $(BUILD_DEPS)
 
 # every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
 # engine whose extra is missing has its tests skipped with the reason, and under CI=true
-# (.ci/run) such a skip fails the run (tests/conftest.py)
+# (.ci/run) they fail instead (tests/conftest.py)
 # The suite starts hundreds of Python processes (every worker, every CLI test): byte-code
 # caches are written even where the environment sets PYTHONDONTWRITEBYTECODE, so that each
 # process reads the project's modules (and pytest its rewritten tests) compiled once.
