@@ -12,10 +12,14 @@ from scipy.integrate._ivp import dop853_coefficients as scipy_dop
 from reference import quaternion as qt
 from reference.core import dop853_tableau as tab
 from reference.core.contacts import contact_frame, vertex_lever
-from reference.core.dop853 import INT_CROSSING, INT_DONE, integrate_held
-from reference.core.held import held_rhs, new_work
+from reference.core.dop853 import INT_CROSSING, INT_DONE
 from reference.core.records import RIM_VERTEX_ON_PLANE
-from tests.conftest import core_model, empty_output, make_scene
+from tests.conftest import core_model, make_scene
+from tests.core_calls import (
+    held_rhs_as_the_loop_does,
+    heun_euler_step_as_the_loop_does,
+    integrate_held_as_the_loop_does,
+)
 
 
 def test_tableau_is_scipys():
@@ -51,11 +55,10 @@ def _held_state(two: bool):
 
 def _held_motion(model, pts, idx, m):
     """f(t, y) of the held motion of contacts idx[:m], for solve_ivp."""
-    scratch = new_work()
 
     def rhs(_t, y):
         dy = np.empty(13)
-        held_rhs(np.ascontiguousarray(y), model, pts, idx, m, scratch[0], dy)
+        held_rhs_as_the_loop_does(np.ascontiguousarray(y), model, pts, idx, m, dy)
         return dy
 
     return rhs
@@ -81,12 +84,7 @@ def test_integration_is_scipys_dop853_step_for_step(two):
 
     ref = solve_ivp(rhs, (0.0, 0.3), y0, method="DOP853", rtol=rtol, atol=atol)
     y = y0.copy()
-    out = empty_output()
-    ours = new_work()
-    r = integrate_held(
-        y, 0.3, model, pts, idx, m, rtol, atol, ours[0], ours[0], (0, 1.0, 0), out,
-        (0.0, 0.0), 0, False, np.zeros(0, dtype=np.int64), 0, 0.0, False,
-    )  # fmt: skip
+    r = integrate_held_as_the_loop_does(y, 0.3, model, pts, idx, m, rtol, atol)
     assert r.status == INT_DONE
     assert r.nfev == ref.nfev
     np.testing.assert_allclose(y, ref.y[:, -1], rtol=0, atol=1e-13)
@@ -110,13 +108,8 @@ def test_crossing_is_located_where_scipys_event_finds_it():
     t_ref = min(te[0] for te in ref.t_events if len(te))
     first = [k + 1 for k, te in enumerate(ref.t_events) if len(te) and te[0] == t_ref]
     y = y0.copy()
-    out = empty_output()
     watch = np.arange(1, 5, dtype=np.int64)
-    ws = new_work()[0]
-    r = integrate_held(
-        y, 2.0, model, pts, idx, m, rtol, atol, ws, ws, (0, 1.0, 0), out,
-        (0.0, 0.0), 0, False, watch, 4, 0.0, False,
-    )  # fmt: skip
+    r = integrate_held_as_the_loop_does(y, 2.0, model, pts, idx, m, rtol, atol, watch)
     assert r.status == INT_CROSSING
     assert abs(r.s - t_ref) < 1e-10
     assert abs(contact_frame(y, RIM_VERTEX_ON_PLANE, pts, first[0]).gap) < 1e-12
@@ -127,15 +120,12 @@ def test_heun_euler_step_is_the_motion_to_roundoff_on_a_short_step_and_rejects_a
     pentagon rocking on one held vertex it agrees with scipy's DOP853 at rtol 1e-13 to
     roundoff and accepts at rtol 1e-12; its estimate grows as h² (×100 for 10× the
     step) and rejects a step of 1e-3 s."""
-    from reference.core.dop853 import heun_euler_step
-
     model, pts, idx, m, y0, rhs = _rocking_pentagon()
     rtol, atol = 1e-12, np.full(13, 1e-14)
 
     def step(h):
-        ws = new_work()[0]
         f0, y1 = rhs(0.0, y0), np.empty(13)
-        err = heun_euler_step(y0, f0, h, rtol, atol, model, pts, idx, m, ws, ws, y1)
+        err = heun_euler_step_as_the_loop_does(y0, f0, h, rtol, atol, model, pts, idx, m, y1)
         return err, y1
 
     err, y1 = step(1e-7)

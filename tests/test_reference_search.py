@@ -11,10 +11,10 @@ from reference import ReferenceOptions, simulate
 from reference import quaternion as qt
 from reference.core.flight import flight_bounds, flight_constants
 from reference.core.records import EVENT_IMPACT, EVENT_NONE, RIM_VERTEX_ON_PLANE
-from reference.core.search import find_flight_event
 from reference.geometry import initial_state
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
 from tests.conftest import core_model, flight, gaps, make_scene
+from tests.core_calls import find_flight_event_as_the_loop_does
 from tests.oracle.body import BodyModel
 from tests.oracle.events import next_flight_event
 from tests.oracle.flight import flight_constants as oracle_flight_constants
@@ -70,10 +70,8 @@ def _product_event(scene, y, window):
     fc = flight_constants(y, scene.body.inertia_diag[0], scene.body.inertia_diag[2])
     bounds = flight_bounds(y, fc, model, pts, 10.0)
     out, together = y.copy(), np.empty(len(pts), dtype=np.int64)  # out: the state at 0
-    res = np.empty(5)
-    ev = find_flight_event(
-        y, fc, bounds, model, pts, window, 0.0, 10.0, 100_000, out, together, res
-    )
+    ev = find_flight_event_as_the_loop_does(y, fc, bounds, model, pts, window, 0.0, 10.0, out,
+                                            together)  # fmt: skip
     return ev, sorted(together[: ev.n_together].tolist())
 
 

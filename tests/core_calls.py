@@ -1,0 +1,119 @@
+"""Core functions called from Python with the argument types the event loop passes them.
+
+numba compiles a function, and everything it calls, once per combination of argument
+types.  The loop passes states, contact lists and tolerances as fields of its records
+(numba's NestedArray); a test that passes NumPy arrays instead gets another compilation
+of the function and its callees (seconds for the integrator and the flight search), of a
+specialisation the loop never runs.  These wrappers copy the test's arrays into the
+fields of a run record (reference.core.records.RUN) and call the function as the loop
+does (reference/core/phases.py and search.py), so that the machine code tested is
+the loop's, loaded from numba's cache where the core's build left it."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from reference.core.dop853 import heun_euler_step, integrate_held
+from reference.core.held import held_rhs
+from reference.core.jit import FALSE, ZERO, copy_into
+from reference.core.output import Output
+from reference.core.phases import NO_GRID
+from reference.core.records import RUN
+from reference.core.search import find_flight_event
+
+MAX_ITERATIONS = 100_000  # the flight search's cap, as the loop passes it (a constant)
+
+
+def new_run():
+    """A zeroed run record for the wrappers below: keep the array, pass its [0]."""
+    return np.zeros(1, dtype=RUN)
+
+
+@njit
+def _copy_ints(dst, src, n):
+    for i in range(n):
+        dst[i] = src[i]
+
+
+@njit
+def _integrate(y, s_end, model, pts, idx, m, rtol, atol, run, watch, n_watch):
+    ws, state = run.scratch, run.state
+    copy_into(ws.y_chunk, y)
+    copy_into(ws.atol, atol)
+    _copy_ints(state.active, idx, 3)
+    out = Output(
+        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
+        np.zeros((1, 6)), np.zeros(1), run.counts,
+    )  # fmt: skip
+    r = integrate_held(
+        ws.y_chunk, s_end, model, pts, state.active, m, rtol, ws.atol, ws, ws, NO_GRID, out,
+        (0.0, 0.0), ZERO, FALSE, watch, n_watch, 0.0, FALSE,
+    )  # fmt: skip
+    copy_into(y, ws.y_chunk)
+    return r
+
+
+def integrate_held_as_the_loop_does(y, s_end, model, pts, idx, m, rtol, atol, watch=None):
+    """dop853.integrate_held from y (updated in place) over [0, s_end], with no samples,
+    lift-off not watched, and the gaps of `watch` (contacts) watched when given."""
+    watch = np.zeros(0, dtype=np.int64) if watch is None else watch
+    run = new_run()
+    idx3 = np.zeros(3, dtype=np.int64)
+    idx3[: len(idx)] = idx
+    return _integrate(y, s_end, model, pts, idx3, m, rtol, atol, run[0], watch, len(watch))
+
+
+@njit
+def _heun_euler(y, f0, h, rtol, atol, model, pts, idx, m, run, y_new):
+    ws, state = run.scratch, run.state
+    copy_into(state.y, y)
+    copy_into(ws.f, f0)
+    copy_into(ws.atol, atol)
+    _copy_ints(state.active, idx, 3)
+    err = heun_euler_step(
+        state.y, ws.f, h, rtol, ws.atol, model, pts, state.active, m, ws, ws, ws.y_chunk
+    )
+    copy_into(y_new, ws.y_chunk)
+    return err
+
+
+def heun_euler_step_as_the_loop_does(y, f0, h, rtol, atol, model, pts, idx, m, y_new):
+    """dop853.heun_euler_step from (y, f0 = f(y)) into y_new; returns its error estimate."""
+    return _heun_euler(y, f0, h, rtol, atol, model, pts, idx, m, new_run()[0], y_new)
+
+
+@njit
+def _held_rhs(y, model, pts, idx, m, run, dy):
+    ws, state = run.scratch, run.state
+    copy_into(state.y, y)
+    _copy_ints(state.active, idx, 3)
+    held_rhs(state.y, model, pts, state.active, m, ws, ws.f)
+    copy_into(dy, ws.f)
+
+
+def held_rhs_as_the_loop_does(y, model, pts, idx, m, dy):
+    """held.held_rhs: f(y) of the motion holding contacts idx[:m], into dy."""
+    _held_rhs(y, model, pts, idx, m, new_run()[0], dy)
+
+
+@njit
+def _find_flight_event(y0, fc, bounds, model, pts, window, s_start, horizon, y, together, run):
+    ws = run.scratch
+    copy_into(ws.y_start, y0)
+    copy_into(ws.y_event, y)
+    ev = find_flight_event(
+        ws.y_start, fc, bounds, model, pts, window, s_start, horizon, MAX_ITERATIONS,
+        ws.y_event, together, ws.res,
+    )  # fmt: skip
+    copy_into(y, ws.y_event)
+    return ev
+
+
+def find_flight_event_as_the_loop_does(y0, fc, bounds, model, pts, window, s_start, horizon, y,
+                                       together):  # fmt: skip
+    """search.find_flight_event from y0 (y: the state at s_start, left at the event)."""
+    run = new_run()
+    return _find_flight_event(
+        y0, fc, bounds, model, pts, window, s_start, horizon, y, together, run[0]
+    )
