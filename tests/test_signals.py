@@ -30,11 +30,26 @@ LONG_REFERENCE_RUN = LONG_REFERENCE_RUN.replace("t_end = 20.0", "t_end = 1e6")
 LONG_REFERENCE_RUN = LONG_REFERENCE_RUN.replace("max_impacts = 100000", "max_impacts = 10000000")
 
 
+# SIGINT with Python's own handler, as an interactive shell starts a command: a test run
+# started in the background (`make test &`, `nohup`) inherits SIGINT ignored, and the
+# harness leaves an ignored SIGINT ignored (harness.signals.handled).
+PYTHONS_SIGINT = "import signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+
+
+@pytest.fixture
+def pythons_sigint():
+    """SIGINT handled by Python (KeyboardInterrupt) in this process for the test."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 def _start(argv: list[str], cwd: Path) -> subprocess.Popen:
-    """`harness ARGV` in a child that says `ready` on stderr once main() runs."""
+    """`harness ARGV` in a child that says `ready` on stderr once main() runs (SIGINT
+    handled by Python there, whatever this process inherited)."""
     code = (
-        "import sys, harness.cli as c; sys.stderr.write('ready\\n'); sys.stderr.flush(); "
-        f"sys.exit(c.main({argv!r}))"
+        f"{PYTHONS_SIGINT}import sys, harness.cli as c; sys.stderr.write('ready\\n'); "
+        f"sys.stderr.flush(); sys.exit(c.main({argv!r}))"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.Popen(
@@ -95,13 +110,12 @@ def toy(tmp_path, monkeypatch):
     [(signal.SIGTERM, 143, "terminated (SIGTERM)"), (signal.SIGINT, 130, "interrupted (Ctrl-C)")],
 )
 def test_a_signal_in_engine_stepping_names_itself_and_exits_with_its_status(
-    toy, tmp_path, capsys, sig, status, reason
+    toy, pythons_sigint, tmp_path, capsys, sig, status, reason
 ):
     """In Python stepping (engines.stepping.run_steps) the run ends `failed` with the
     signal's reason, the steps so far kept in the summary, and no file written.  The run
     is bounded (200,000 toy steps, ~20 s here), so that a signal that does not stop it
     fails the test instead of holding its worker for the scene's whole 3 s (minutes)."""
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # Python's own
     out = tmp_path / "toy.parquet"
     argv = ["simulate", "triangle-chatter", "--engine", "toy", "--dt", "1e-6", "--t-end", "0.2"]
     timer = threading.Timer(1.0, os.kill, (os.getpid(), sig))
@@ -156,7 +170,8 @@ def test_a_signal_is_forgotten_once_its_command_ended(toy, tmp_path):
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGTERM))
     timer.start()
     try:
-        code = main(["simulate", "triangle-chatter", "--engine", "toy", "--dt", "1e-6"])
+        code = main(["simulate", "triangle-chatter", "--engine", "toy", "--dt", "1e-6",
+                     "--t-end", "0.2"])  # fmt: skip
     finally:
         timer.cancel()
     assert code == signals.EXIT_TERMINATED and signals.received() is None
