@@ -28,7 +28,6 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
-import signal
 import stat
 import tempfile
 import time
@@ -122,7 +121,7 @@ def atomic_outputs(paths: Sequence[str | os.PathLike], force: bool = False) -> I
         for target in targets:
             created += _make_folders(target.parent)
             remove_stale_temporaries(target.parent)
-            with _signals_held():  # created and listed, or neither (SIGTERM, Ctrl-C)
+            with signals.deferred():  # created and listed, or neither (SIGTERM, Ctrl-C)
                 fd, name = tempfile.mkstemp(
                     dir=target.parent, prefix=temp_prefix(), suffix=target.suffix or None
                 )
@@ -163,20 +162,6 @@ def write_bytes(path: str | os.PathLike, data: bytes, force: bool = False) -> Pa
             fh.write(data)
         _check_contents(tmp, data)
     return Path(path)
-
-
-HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
-
-
-@contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
-    """Ctrl-C and SIGTERM held back while the block runs, delivered right after it: a
-    temporary file is never created without being listed for its cleanup."""
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def temp_prefix() -> str:

@@ -69,6 +69,31 @@ def _on_sigint(signum, frame) -> None:
 
 
 @contextlib.contextmanager
+def deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM deferred while the block runs and delivered right after it, so
+    that their handlers never cut it (a temporary file created and not yet listed for its
+    cleanup).  Their Python handlers are swapped for one that notes the signal: Python
+    runs a signal's handler in the main thread whichever thread the kernel delivers the
+    signal to, so blocking it in one thread (pthread_sigmask) does not hold it back.
+    Outside the main thread, where no handler runs, the block runs as it is."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    noted: list[int] = []
+    previous = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        if callable(signal.getsignal(sig)):  # not SIG_DFL, SIG_IGN, or a C handler
+            previous[sig] = signal.signal(sig, lambda signum, _frame: noted.append(signum))
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        for signum in noted:
+            signal.raise_signal(signum)
+
+
+@contextlib.contextmanager
 def handled() -> Iterator[None]:
     """SIGTERM raises Terminated and SIGINT KeyboardInterrupt while the block runs, both
     remembered (main thread only; elsewhere Python's handlers stay)."""

@@ -176,3 +176,19 @@ def test_a_signal_is_forgotten_once_its_command_ended(toy, tmp_path):
         timer.cancel()
     assert code == signals.EXIT_TERMINATED and signals.received() is None
     assert write_text(tmp_path / "after.txt", "fine").read_text() == "fine"
+
+
+def test_a_signal_during_a_deferred_block_is_delivered_after_it():
+    """signals.deferred: a SIGTERM sent inside the block (from another thread, as the
+    kernel may deliver it there) does not cut the block; it is raised right after it."""
+    steps = []
+    with pytest.raises(signals.Terminated), signals.handled():
+        with signals.deferred():
+            sender = threading.Thread(target=os.kill, args=(os.getpid(), signal.SIGTERM))
+            sender.start()
+            sender.join()
+            for _ in range(1000):  # bytecode boundaries, where Python runs handlers
+                time.sleep(0)
+            steps.append("the block ran to its end")
+        steps.append("after the block")
+    assert steps == ["the block ran to its end"]
