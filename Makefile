@@ -11,17 +11,11 @@ STAMP_ALL := $(VENV)/.installed-all
 # installed first: the reference's compiled core needs nothing else to build
 BUILD_DEPS := $(VENV)/.build-deps
 # the reference's compiled core, built ahead of time by `python -m reference.core.aot`
-# (skipped without a C compiler: it is then compiled just in time on first use) into two
-# modules: the event loop (AOT, 2-3 min on one core) and the row-wise functions with the
-# multi-contact impact (AOT_ROWS, ~30 s); each is rebuilt when the sources change and
-# left alone when fresh.  The installs leave them out of pip's build
-# (EULER_DISK_BUILD_CORE=0, setup.py): the loop compiles on one core while the other
-# builds the second module, installs the packages and fills the linear kernel's cache
-# (make -j2).  The second module's build keeps numba's cache apart (NUMBA_CACHE_DIR):
-# numba's on-disk cache is not safe for two processes that save different signatures of
-# one function at the same time.
+# (skipped without a C compiler: it is then compiled just in time on first use); it
+# rebuilds the module when its sources change and does nothing when it is fresh.  The
+# installs leave it out of pip's build (EULER_DISK_BUILD_CORE=0, setup.py) so that it
+# compiles on one core while pip installs the packages on the other (make -j2).
 AOT    := $(VENV)/.aot
-AOT_ROWS := $(VENV)/.aot-rows
 CORE   := $(wildcard reference/core/*.py)
 LINEAR := $(wildcard reference/linear/*.py)
 WARM   := $(VENV)/.warm
@@ -40,33 +34,25 @@ $(BUILD_DEPS): pyproject.toml
 	$(BIN)/pip install --progress-bar off $(BUILD_REQUIRES)
 	touch $(BUILD_DEPS)
 
-# the package and its core dependencies: the demo's needs.  --no-compile: Python writes
-# the byte-code of the modules that are imported, when they are first imported, instead
-# of pip compiling every module installed (40 s of the 80 s install with every extra)
-$(STAMP): $(BUILD_DEPS) | $(AOT_ROWS)
+# the package and its core dependencies: the demo's needs
+$(STAMP): $(BUILD_DEPS)
 	@echo "set-up 2/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
 	@echo "  beside step 3/3"
-	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off --no-compile -e .
+	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e .
 	touch $(STAMP)
 
 # every extra ([all]: drake, dart, mjx, dask) and the dev tools
-$(STAMP_ALL): $(BUILD_DEPS) | $(AOT_ROWS)
+$(STAMP_ALL): $(BUILD_DEPS)
 	@echo "set-up 2/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
 	@echo "  (2.5 GB in all), beside step 3/3"
-	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off --no-compile -e '.[all,dev]'
+	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e '.[all,dev]'
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
-	@echo "set-up 3/3: the reference's event loop compiled ahead of time (about 2–3 min on one"
-	@echo "  core, beside step 2/3; rebuilt when its sources change)"
-	$(BIN)/python -m reference.core.aot --part _aot
+	@echo "set-up 3/3: the reference's compiled core (about 2–3 min on one core, beside step"
+	@echo "  2/3; rebuilt when its sources change)"
+	$(BIN)/python -m reference.core.aot
 	touch $(AOT)
-
-$(AOT_ROWS): $(BUILD_DEPS) $(CORE)
-	@echo "set-up 2/3: the core's row-wise functions compiled ahead of time (about 40 s),"
-	@echo "  beside step 3/3"
-	NUMBA_CACHE_DIR=$(VENV)/.numba-cache-rows $(BIN)/python -m reference.core.aot --part _aot_rows
-	touch $(AOT_ROWS)
 
 # numba's cache of the linear model's kernel (compiled just in time: reference/warm.py),
 # filled once the packages are in (PACKAGES: the install it waits for), while the core's

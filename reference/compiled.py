@@ -1,12 +1,11 @@
 """Access to the compiled event loop: ahead-of-time when it has been built, else numba's
 just-in-time compilation with its on-disk cache.
 
-`make setup` builds the core ahead of time (`python -m reference.core.aot`, a C compiler
-needed) into two extension modules beside the sources, `_aot` (the event loop) and
-`_aot_rows` (the row-wise functions and the multi-contact impact), built side by side on
-two cores; they import in milliseconds and need no numba at run time.  A stamp of the
-core's source files is stored with each: when the sources change, the stale modules are
-ignored and the core is compiled just in time (cached in __pycache__ after the first run).
+`make setup` builds the loop ahead of time (`python -m reference.core.aot`, a C
+compiler needed) into an extension module beside the sources; it imports in
+milliseconds and needs no numba at run time.  A stamp of the core's source files is
+stored with it: when the sources change, the stale module is ignored and the loop is
+compiled just in time (cached in __pycache__ after the first run).
 `reference.simulate.load_event_loop` does the one-time work (compilation, or loading the
 cache) apart, so that run times never include it.  This module imports no other module of
 the package (reference.geometry imports it)."""
@@ -19,6 +18,8 @@ import os
 from pathlib import Path
 
 CORE_DIR = Path(__file__).with_name("core")
+AOT_MODULE = "reference.core._aot"
+STAMP_FILE = CORE_DIR / "_aot.stamp"
 # the folders whose njit functions numba caches on disk (in their __pycache__)
 JIT_CACHED = (CORE_DIR, CORE_DIR.parent / "linear")
 
@@ -37,15 +38,6 @@ EXPORTS = {
     "length_scale_rows": "arrays",
     "multi_impact": "multi_impact",
 }
-
-# the ahead-of-time modules (reference.core.<part>) and the exported functions in each:
-# the event loop alone in one, everything else in the other, so that the two build side
-# by side in about the same time as the rest of the set-up (Makefile)
-AOT_PARTS = {
-    "_aot": ("run_events",),
-    "_aot_rows": tuple(name for name in EXPORTS if name != "run_events"),
-}
-PART_OF = {name: part for part, names in AOT_PARTS.items() for name in names}
 
 _aot = None
 _aot_checked = False
@@ -67,32 +59,24 @@ def source_stamp() -> str:
     return _sources_stamp((CORE_DIR,))
 
 
-def stamp_file(part: str) -> Path:
-    """The stamp of the sources an ahead-of-time module was built from."""
-    return CORE_DIR / f"{part}.stamp"
-
-
 def _load_aot():
-    """The ahead-of-time modules {part: module} if every one exists and matches the
-    sources (None when one does not, or when the environment variable EULER_DISK_NO_AOT
-    is set)."""
+    """The ahead-of-time module if it exists and matches the sources (None when the
+    environment variable EULER_DISK_NO_AOT is set)."""
     if os.environ.get("EULER_DISK_NO_AOT"):
         return None
-    modules = {part: fresh_aot_module(part) for part in AOT_PARTS}
-    return None if None in modules.values() else modules
+    return fresh_aot_module()
 
 
-def fresh_aot_module(part: str):
-    """The ahead-of-time module `part` beside the sources if its stamp matches them, else
-    None."""
+def fresh_aot_module():
+    """The ahead-of-time module beside the sources if its stamp matches them, else None."""
     try:
-        stamp = stamp_file(part).read_text().strip()
+        stamp = STAMP_FILE.read_text().strip()
     except OSError:
         return None
     if stamp != source_stamp():
         return None
     try:
-        return importlib.import_module(f"reference.core.{part}")
+        return importlib.import_module(AOT_MODULE)
     except ImportError:
         return None
 
@@ -123,7 +107,7 @@ def clear_stale_jit_cache() -> None:
         pass
 
 
-def _aot_modules():
+def _aot_module():
     global _aot, _aot_checked
     if not _aot_checked:
         _aot, _aot_checked = _load_aot(), True
@@ -140,9 +124,9 @@ def jit_function(name: str):
 def function(name: str):
     """A compiled function of the core (EXPORTS): ahead-of-time if built and fresh,
     else just in time."""
-    modules = _aot_modules()
-    if modules is not None:
-        return getattr(modules[PART_OF[name]], name)
+    aot = _aot_module()
+    if aot is not None:
+        return getattr(aot, name)
     return jit_function(name)
 
 
@@ -153,7 +137,7 @@ def run_events():
 
 def kernel_source() -> str:
     """'ahead-of-time' or 'just-in-time'."""
-    return "ahead-of-time" if _aot_modules() is not None else "just-in-time"
+    return "ahead-of-time" if _aot_module() is not None else "just-in-time"
 
 
 def jit_cached() -> bool:

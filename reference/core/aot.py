@@ -1,13 +1,11 @@
-"""Build the core ahead of time: `python -m reference.core.aot` (`--part _aot` or
-`--part _aot_rows` for one of its two modules: `make setup` builds them side by side; the
+"""Build the core ahead of time: `python -m reference.core.aot` (run by `make setup`; the
 package's build step, setup.py, calls `build` too, so `pip install .`, `pip install -e .`
-and `pip wheel .` carry the same modules).  numba.pycc compiles the event loop
-`loop.run_events` into reference/core/_aot*.so, and the row-wise functions of `arrays`
-and `multi_impact.multi_impact` into reference/core/_aot_rows*.so (each with everything
-it calls), and writes a stamp of the core's sources beside each (reference.compiled
-ignores the modules once the sources change).  Needs a C compiler; without one (or
-without numba.pycc) the functions are compiled just in time on first use instead.  Why
-pycc: docs/development.md."""
+and `pip wheel .` carry the same module).  numba.pycc compiles the event loop
+`loop.run_events` and the row-wise functions of `arrays` (and everything they call) into
+the extension module reference/core/_aot*.so, and a stamp of the core's sources is
+written beside it (reference.compiled ignores the module once the sources change).
+Needs a C compiler; without one (or without numba.pycc) the functions are compiled just
+in time on first use instead.  Why pycc: docs/development.md."""
 
 from __future__ import annotations
 
@@ -52,28 +50,26 @@ def signatures() -> dict:
     }
 
 
-def build(part: str, output_dir: Path = CORE_DIR) -> Path:
-    """Compile the module `part` (reference.compiled.AOT_PARTS) into output_dir and write
-    its stamp there; returns the module's path.  The module already there goes first: a
-    failed build leaves none (of older sources) behind."""
-    from reference.compiled import AOT_PARTS, jit_function, source_stamp, stamp_file
+def build(output_dir: Path = CORE_DIR) -> Path:
+    """Compile the module into output_dir and write its stamp there; returns the
+    module's path.  Any module already there goes first: a failed build leaves none (of
+    older sources) behind."""
+    from reference.compiled import STAMP_FILE, jit_function, source_stamp
 
     output_dir.mkdir(parents=True, exist_ok=True)
-    stamp = output_dir / stamp_file(part).name
-    for old in [*output_dir.glob(f"{part}.*.so"), output_dir / f"{part}.so", stamp]:
+    for old in [*output_dir.glob("_aot*.so"), output_dir / STAMP_FILE.name]:
         old.unlink(missing_ok=True)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # pycc announces its pending deprecation
         from numba.pycc import CC
 
-    cc = CC(part)
+    cc = CC("_aot")
     cc.output_dir = str(output_dir)
     cc.verbose = False
-    sigs = signatures()
-    for name in AOT_PARTS[part]:
-        cc.export(name, sigs[name])(jit_function(name).py_func)
+    for name, sig in signatures().items():
+        cc.export(name, sig)(jit_function(name).py_func)
     cc.compile()
-    stamp.write_text(source_stamp() + "\n")
+    (output_dir / STAMP_FILE.name).write_text(source_stamp() + "\n")
     return output_dir / cc.output_file
 
 
@@ -106,24 +102,17 @@ def repeated_signatures(counts: dict[str, int]) -> str:
     return f"{line}; compiled more than once: {listed}"
 
 
-BUILDING = {  # what each module holds, and how long it takes to build on one core
-    "_aot": ("the reference's event loop", "about 2–3 min"),
-    "_aot_rows": ("the core's row-wise functions and multi-contact impact", "about 40 s"),
-}
-
-
-def build_or_explain(part: str, output_dir: Path = CORE_DIR) -> Path | None:
+def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
     """`build`, timed and announced; when it cannot be done (no C compiler, no
-    numba.pycc) one line on stderr says so and None is returned: the core is then
+    numba.pycc) one line on stderr says so and None is returned: the loop is then
     compiled just in time on first use."""
     t0 = time.perf_counter()
-    what, how_long = BUILDING[part]
-    print(f"building {what} ahead of time ({how_long}) ...", flush=True)
+    print("building the reference's event loop ahead of time (about 2–3 min) ...", flush=True)
     try:
-        path = build(part, output_dir)
+        path = build(output_dir)
     except Exception as exc:  # any failure: the loop is compiled just in time instead
         reason = " ".join(f"{type(exc).__name__}: {exc}".split())  # one line
-        print(f"ahead-of-time build skipped ({reason}); the core will be compiled just in "
+        print(f"ahead-of-time build skipped ({reason}); the loop will be compiled just in "
               "time on first use", file=sys.stderr)  # fmt: skip
         return None
     print(f"built {path.name} in {time.perf_counter() - t0:.0f} s", flush=True)
@@ -132,23 +121,14 @@ def build_or_explain(part: str, output_dir: Path = CORE_DIR) -> Path | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Build each module (`--part NAME`: that one) unless it is already fresh beside the
-    sources (`--force`: always)."""
-    from reference.compiled import AOT_PARTS, fresh_aot_module
+    """Build unless the module beside the sources is already fresh (`--force`: always)."""
+    from reference.compiled import fresh_aot_module
 
     args = sys.argv[1:] if argv is None else argv
-    parts = list(AOT_PARTS)
-    if "--part" in args:
-        i = args.index("--part") + 1
-        if i >= len(args) or args[i] not in AOT_PARTS:
-            print(f"--part: one of {', '.join(AOT_PARTS)}", file=sys.stderr)
-            return 2
-        parts = [args[i]]
-    for part in parts:
-        if "--force" not in args and fresh_aot_module(part) is not None:
-            print(f"the reference's ahead-of-time module {part} is up to date", flush=True)
-        else:
-            build_or_explain(part)
+    if "--force" not in args and fresh_aot_module() is not None:
+        print("the reference's ahead-of-time module is up to date", flush=True)
+        return 0
+    build_or_explain()
     return 0
 
 
