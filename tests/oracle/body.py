@@ -37,10 +37,14 @@ X, Q, V, W = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b for 3-vectors or stacks of them (rows); much cheaper than np.cross."""
+    """a × b for 3-vectors or stacks of them (rows); much cheaper than np.cross (two
+    3-vectors, the common case, without np.stack's overhead)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+    c = (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+    if a.ndim == 1 and b.ndim == 1:
+        return np.array(c)
+    return np.stack(c, axis=-1)
 
 
 def bumpy_points(scene: Scene) -> np.ndarray:
