@@ -30,10 +30,11 @@ def new_run():
     return np.zeros(1, dtype=RUN)
 
 
-@njit
-def _copy_ints(dst, src, n):
-    for i in range(n):
-        dst[i] = src[i]
+def held_list(idx) -> np.ndarray:
+    """The held contacts idx as the loop's list of three (state.active), zero-padded."""
+    active = np.zeros(3, dtype=np.int64)
+    active[: len(idx)] = idx
+    return active
 
 
 @njit
@@ -41,7 +42,7 @@ def _integrate(y, s_end, model, pts, idx, m, rtol, atol, run, watch, n_watch):
     ws, state = run.scratch, run.state
     copy_into(ws.y_chunk, y)
     copy_into(ws.atol, atol)
-    _copy_ints(state.active, idx, 3)
+    copy_into(state.active, idx)
     out = Output(
         np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
         np.zeros((1, 6)), np.zeros(1), run.counts,
@@ -59,9 +60,9 @@ def integrate_held_as_the_loop_does(y, s_end, model, pts, idx, m, rtol, atol, wa
     lift-off not watched, and the gaps of `watch` (contacts) watched when given."""
     watch = np.zeros(0, dtype=np.int64) if watch is None else watch
     run = new_run()
-    idx3 = np.zeros(3, dtype=np.int64)
-    idx3[: len(idx)] = idx
-    return _integrate(y, s_end, model, pts, idx3, m, rtol, atol, run[0], watch, len(watch))
+    return _integrate(
+        y, s_end, model, pts, held_list(idx), m, rtol, atol, run[0], watch, len(watch)
+    )
 
 
 @njit
@@ -70,7 +71,7 @@ def _heun_euler(y, f0, h, rtol, atol, model, pts, idx, m, run, y_new):
     copy_into(state.y, y)
     copy_into(ws.f, f0)
     copy_into(ws.atol, atol)
-    _copy_ints(state.active, idx, 3)
+    copy_into(state.active, idx)
     err = heun_euler_step(
         state.y, ws.f, h, rtol, ws.atol, model, pts, state.active, m, ws, ws, ws.y_chunk
     )
@@ -80,21 +81,23 @@ def _heun_euler(y, f0, h, rtol, atol, model, pts, idx, m, run, y_new):
 
 def heun_euler_step_as_the_loop_does(y, f0, h, rtol, atol, model, pts, idx, m, y_new):
     """dop853.heun_euler_step from (y, f0 = f(y)) into y_new; returns its error estimate."""
-    return _heun_euler(y, f0, h, rtol, atol, model, pts, idx, m, new_run()[0], y_new)
+    run = new_run()
+    return _heun_euler(y, f0, h, rtol, atol, model, pts, held_list(idx), m, run[0], y_new)
 
 
 @njit
 def _held_rhs(y, model, pts, idx, m, run, dy):
     ws, state = run.scratch, run.state
     copy_into(state.y, y)
-    _copy_ints(state.active, idx, 3)
+    copy_into(state.active, idx)
     held_rhs(state.y, model, pts, state.active, m, ws, ws.f)
     copy_into(dy, ws.f)
 
 
 def held_rhs_as_the_loop_does(y, model, pts, idx, m, dy):
     """held.held_rhs: f(y) of the motion holding contacts idx[:m], into dy."""
-    _held_rhs(y, model, pts, idx, m, new_run()[0], dy)
+    run = new_run()
+    _held_rhs(y, model, pts, held_list(idx), m, run[0], dy)
 
 
 @njit

@@ -12,10 +12,9 @@ each fixed-step run's wall time is predicted (`predict_run_time`: pilot runs for
 ones, and an extrapolation from the same engine and dt at the smaller scales already
 run) and the run is skipped when the prediction exceeds the per-run budget; a run of
 more than PILOT_FREE_STEPS steps runs in a child process (harness.child_processes)
-stopped at HARD_CAP_FACTOR × the
-budget (predictions can miss costly later phases).  Once a scale is skipped or
-stopped, the larger scales of that engine and dt are skipped too: they cover the same
-motion with more steps.
+stopped at HARD_CAP_FACTOR × the budget (predictions can miss costly later phases).
+Once a scale is skipped or stopped, the larger scales of that engine and dt are
+skipped too: they cover the same motion with more steps.
 """
 
 from __future__ import annotations
