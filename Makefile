@@ -84,10 +84,13 @@ demo: $(BUILD_DEPS)
 # process reads the project's modules (and pytest its rewritten tests) compiled once.
 # --dist loadfile: each test file runs whole on one worker, so that its module-scoped
 # fixtures (the report's documents), the compilations its tests share (the integrator's
-# tests, MJX's scans) and its imports are done once, not once per worker.
+# tests, MJX's scans) and its imports are done once, not once per worker;
+# --no-loadscope-reorder: the files are handed out in the order tests/schedule.py gives
+# them (pool-starting files before JAX's, then the longest first).
 TEST_WORKERS ?= auto
 test: setup
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile
+	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile \
+		--no-loadscope-reorder
 
 test-slow: setup
 	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -m slow

@@ -18,6 +18,7 @@ import pytest
 
 from reference import quaternion as qt
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
+from tests.schedule import JAX_AT_COLLECTION, jax_loaded, ordered
 
 os.environ.setdefault(
     "JAX_COMPILATION_CACHE_DIR", str(Path(__file__).resolve().parents[1] / ".cache" / "jax")
@@ -93,10 +94,17 @@ def fork_children(monkeypatch):
 
 
 def pytest_collection_modifyitems(items) -> None:
-    """The tests that fork on purpose (`fork_children`) do not show JAX's fork warning."""
+    """The test files in the order `make test`'s workers take them (tests/schedule.py);
+    the tests that fork on purpose (`fork_children`) do not show JAX's fork warning."""
+    items[:] = ordered(items)
     for item in items:
         if "fork_children" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"))
+
+
+def pytest_collection_finish(session) -> None:
+    """Notes whether collecting the tests loaded JAX (tests/test_schedule.py)."""
+    session.config.stash[JAX_AT_COLLECTION] = jax_loaded()
 
 
 @pytest.fixture

@@ -1,31 +1,39 @@
 """MJX adapter: the model is the `mujoco` engine's with diagexact off; float64 MJX steps
 as MuJoCo C does on that model; `mjx` and `mujoco` give the same impact on
 pentagon-bounce at dt = 1e-4 … 1e-9 while MuJoCo follows the reference; a vmapped batch
-gives the serial runs' trajectories."""
+gives the serial runs' trajectories.
+
+JAX is imported by the `mx` fixture, when the first of these tests runs, not when the file
+is collected: a test process with JAX loaded starts its sweep pools by spawn rather than
+fork (harness/child_processes.py), and every test process collects every file."""
 
 from __future__ import annotations
 
 import dataclasses
 
+import mujoco
 import numpy as np
 import pytest
 
+from engines.mujoco import simulate_mujoco, staggered_start, to_mujoco_state
+from engines.mujoco_model import load_model
+from reference import quaternion as qt
+from reference.scene import InitialState
+from reference.scenes import as_scene
+from reference.simulate import simulate
 from tests.conftest import require_extra
 
-require_extra("jax", "mjx")
-require_extra("mujoco.mjx", "mjx")
-
-import mujoco  # noqa: E402
-
-from engines import mjx as mx  # noqa: E402
-from engines.mujoco import simulate_mujoco, staggered_start, to_mujoco_state  # noqa: E402
-from engines.mujoco_model import load_model  # noqa: E402
-from reference import quaternion as qt  # noqa: E402
-from reference.scene import InitialState  # noqa: E402
-from reference.scenes import as_scene  # noqa: E402
-from reference.simulate import simulate  # noqa: E402
-
 STEPS = 60  # steps of each short run: 30 before the first impact, 30 after
+
+
+@pytest.fixture(scope="module")
+def mx():
+    """engines.mjx, imported (with JAX) when a test of this file first runs."""
+    require_extra("jax", "mjx")
+    require_extra("mujoco.mjx", "mjx")
+    from engines import mjx
+
+    return mjx
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +57,7 @@ def _before_impact(scene, t_impact: float, dt: float):
     return dataclasses.replace(scene, initial=initial).with_run(t_end=STEPS * dt), t0
 
 
-def test_model_is_the_mujoco_engines_with_diagexact_off(bounce):
+def test_model_is_the_mujoco_engines_with_diagexact_off(bounce, mx):
     scene, _ = bounce
     ours, theirs = mx.build_model(scene, 1e-4), load_model(scene, 1e-4, "tuned")
     diagexact = int(mujoco.mjtEnableBit.mjENBL_DIAGEXACT)
@@ -60,7 +68,7 @@ def test_model_is_the_mujoco_engines_with_diagexact_off(bounce):
     assert ours.opt.timestep == theirs.opt.timestep and ours.opt.integrator == 0
 
 
-def test_float64_mjx_steps_as_mujoco_c_on_the_same_model(bounce):
+def test_float64_mjx_steps_as_mujoco_c_on_the_same_model(bounce, mx):
     scene, first = bounce
     dt = 1e-4
     short, _ = _before_impact(scene, first.t, dt)
@@ -84,7 +92,7 @@ def _y0(scene):
 
 
 @pytest.mark.parametrize("dt", [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9])
-def test_mjx_and_mujoco_give_the_same_impact_while_mujoco_follows_the_reference(bounce, dt):
+def test_mjx_and_mujoco_give_the_same_impact_while_mujoco_follows_the_reference(bounce, dt, mx):
     scene, first = bounce
     short, t0 = _before_impact(scene, first.t, dt)
     ours, theirs = mx.simulate_mjx(short, dt), simulate_mujoco(short, dt)
@@ -96,7 +104,7 @@ def test_mjx_and_mujoco_give_the_same_impact_while_mujoco_follows_the_reference(
         assert a.v_normal_post == pytest.approx(b.v_normal_post, rel=1e-3)
 
 
-def test_a_vmapped_batch_gives_the_serial_trajectories(bounce):
+def test_a_vmapped_batch_gives_the_serial_trajectories(bounce, mx):
     scene, first = bounce
     dt = 1e-4
     short, _ = _before_impact(scene, first.t, dt)
@@ -119,7 +127,7 @@ def test_a_vmapped_batch_gives_the_serial_trajectories(bounce):
     assert not np.allclose(batch[0].angular_velocity, batch[1].angular_velocity)
 
 
-def test_float32_mjx_runs_in_float32_and_finds_the_impact(bounce):
+def test_float32_mjx_runs_in_float32_and_finds_the_impact(bounce, mx):
     scene, first = bounce
     dt = 1e-4
     short, t0 = _before_impact(scene, first.t, dt)
@@ -130,7 +138,7 @@ def test_float32_mjx_runs_in_float32_and_finds_the_impact(bounce):
     assert run.stats["compile_time_s"] >= 0 and run.stats["wall_time_s"] > 0
 
 
-def test_runs_of_other_lengths_share_the_compiled_scan_and_agree_step_for_step(bounce):
+def test_runs_of_other_lengths_share_the_compiled_scan_and_agree_step_for_step(bounce, mx):
     """Runs of 60 and 50 steps both run the one compiled scan (CHUNK_STEPS steps): the
     second compiles nothing, and its rows are the first rows of the longer run, bit for
     bit (the angular velocity but at its last row, which the recording forms at the

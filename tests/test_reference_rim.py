@@ -40,7 +40,7 @@ def _oracle_heights(scene, y0, times):
     lowest, circle = [], []
     for s in times:
         y = oracle_flight.free_flight(fc, s)
-        lowest.append(np.min(body.contacts(y)[0]))
+        lowest.append(np.min(body.rim_gaps(y)))
         e3 = qt.body_axis(y[3:7])
         circle.append(y[2] - scene.body.radius * math.hypot(e3[0], e3[1]))
     return np.array(lowest), np.array(circle)

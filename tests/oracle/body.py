@@ -58,6 +58,13 @@ def bumpy_points(scene: Scene) -> np.ndarray:
     return np.stack([b * np.cos(ang), b * np.sin(ang), np.full(3, g.bump_height)], axis=1)
 
 
+def _rim_heights(q: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """(R p)_z of body-frame points p in the plane of the polygon (p_z = 0), formed from
+    the quaternion's small terms directly: R's z-row is (2(xz − wy), 2(yz + wx), ·)."""
+    wq, xq, yq, zq = q
+    return pts[:, 0] * (2 * (xq * zq - wq * yq)) + pts[:, 1] * (2 * (yq * zq + wq * xq))
+
+
 @dataclass(frozen=True)
 class BodyModel:
     mass: float
@@ -143,14 +150,16 @@ class BodyModel:
             out.append(full)
         return tuple(out)
 
+    def rim_gaps(self, y: np.ndarray) -> np.ndarray:
+        """The gaps z + (R p)_z of every rim vertex at state y (`contacts`' first result
+        for the rim contacts, without the rest)."""
+        return y[2] + _rim_heights(y[Q], self.vertices)
+
     def _rim_contacts(self, y: np.ndarray, pts: np.ndarray):
         """Vertices (body frame) on the plane z = 0: gap z + (R p)_z, normal e_z."""
         x, q, v, w = y[X], y[Q], y[V], y[W]
-        R = qt.to_matrix(q)
-        # z-row computed from the small quaternion terms directly
-        wq, xq, yq, zq = q
-        lever = pts @ R.T
-        rz = pts[:, 0] * (2 * (xq * zq - wq * yq)) + pts[:, 1] * (2 * (yq * zq + wq * xq))
+        lever = pts @ qt.to_matrix(q).T
+        rz = _rim_heights(q, pts)
         lever[:, 2] = rz
         gap = x[2] + rz
         normal = np.zeros_like(lever)
