@@ -26,18 +26,22 @@ BUILD_REQUIRES = $(shell $(PYTHON) -c 'import shlex, tomllib; print(shlex.join(t
 
 $(BUILD_DEPS): pyproject.toml
 	@$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), sys.version' || { echo "need Python >= 3.11 (make PYTHON=/path/to/python3.11)"; exit 2; }
-	@echo "set-up 1/3: a virtual environment in $(VENV), pip, and what the reference's compiled"
-	@echo "  core is built with ($(BUILD_REQUIRES)); Python:"
+	@echo "set-up 1/3: a virtual environment in $(VENV) and what the reference's compiled core"
+	@echo "  is built with ($(BUILD_REQUIRES)); Python:"
 	@echo "  $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --progress-bar off --upgrade pip
 	$(BIN)/pip install --progress-bar off $(BUILD_REQUIRES)
 	touch $(BUILD_DEPS)
+
+# pip itself is brought up to date beside the core's build, not before it: the venv's own
+# pip installs the build's requirements, the current one the packages
+PIP_UPGRADE := $(BIN)/pip install --progress-bar off --upgrade pip
 
 # the package and its core dependencies: the demo's needs
 $(STAMP): $(BUILD_DEPS)
 	@echo "set-up 2/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
 	@echo "  beside step 3/3"
+	$(PIP_UPGRADE)
 	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e .
 	touch $(STAMP)
 
@@ -45,6 +49,7 @@ $(STAMP): $(BUILD_DEPS)
 $(STAMP_ALL): $(BUILD_DEPS)
 	@echo "set-up 2/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
 	@echo "  (2.5 GB in all), beside step 3/3"
+	$(PIP_UPGRADE)
 	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e '.[all,dev]'
 	touch $(STAMP) $(STAMP_ALL)
 
