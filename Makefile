@@ -30,18 +30,20 @@ $(BUILD_DEPS): pyproject.toml
 	@echo "  is built with ($(BUILD_REQUIRES)); Python:"
 	@echo "  $(PYTHON)"
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --progress-bar off $(BUILD_REQUIRES)
+	$(BIN)/pip install --progress-bar off --no-compile $(BUILD_REQUIRES)
 	touch $(BUILD_DEPS)
 
-# pip itself is brought up to date beside the core's build, not before it: the venv's own
-# pip installs the build's requirements, the current one the packages
-PIP_UPGRADE := $(BIN)/pip install --progress-bar off --upgrade pip
+# Beside the core's build, not before it: pip brought up to date (the venv's own pip
+# installs the build's requirements, the current one the packages), and the build's
+# requirements byte-compiled (pip's --no-compile above: 7.5 of their 12.7 s install)
+BESIDE_BUILD := $(BIN)/pip install --progress-bar off --upgrade pip && \
+	$(BIN)/python -m compileall -q $(VENV)/lib
 
 # the package and its core dependencies: the demo's needs
 $(STAMP): $(BUILD_DEPS)
 	@echo "set-up 2/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
 	@echo "  beside step 3/3"
-	$(PIP_UPGRADE)
+	$(BESIDE_BUILD)
 	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e .
 	touch $(STAMP)
 
@@ -49,7 +51,7 @@ $(STAMP): $(BUILD_DEPS)
 $(STAMP_ALL): $(BUILD_DEPS)
 	@echo "set-up 2/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
 	@echo "  (2.5 GB in all), beside step 3/3"
-	$(PIP_UPGRADE)
+	$(BESIDE_BUILD)
 	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e '.[all,dev]'
 	touch $(STAMP) $(STAMP_ALL)
 
