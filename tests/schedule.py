@@ -94,4 +94,5 @@ def ordered(items: list) -> list:
 
 
 def jax_loaded() -> bool:
+    """Whether this process has imported JAX (what harness.child_processes checks)."""
     return "jax" in sys.modules
