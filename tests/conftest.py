@@ -93,18 +93,15 @@ def fork_children(monkeypatch):
     monkeypatch.setattr(harness.child_processes, "THREADED_RUNTIMES", ())
 
 
-def pytest_collection_modifyitems(items) -> None:
+def pytest_collection_modifyitems(config, items) -> None:
     """The test files in the order `make test`'s workers take them (tests/schedule.py);
-    the tests that fork on purpose (`fork_children`) do not show JAX's fork warning."""
+    the tests that fork on purpose (`fork_children`) do not show JAX's fork warning; and
+    whether collecting every test file loaded JAX, noted for tests/test_schedule.py."""
+    config.stash[JAX_AT_COLLECTION] = jax_loaded()
     items[:] = ordered(items)
     for item in items:
         if "fork_children" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"))
-
-
-def pytest_collection_finish(session) -> None:
-    """Notes whether collecting the tests loaded JAX (tests/test_schedule.py)."""
-    session.config.stash[JAX_AT_COLLECTION] = jax_loaded()
 
 
 @pytest.fixture
