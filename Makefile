@@ -70,9 +70,20 @@ $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
 	$(BIN)/python -m reference.warm
 	touch $(WARM)
 
+# JAX's compilation cache (.cache/jax) filled with the three programs MJX's tests compile
+# (tests/warm_mjx.py): on the core that the installs and the linear kernel leave idle
+# while the core's build still runs, at the lowest priority so that the build keeps its
+# core (XLA compiles on several threads); the tests' workers then load the programs
+JAX_WARM := $(VENV)/.jax-warm
+$(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
+	@echo "set-up 2/3, last: MJX's scans, for its tests, into JAX's cache"
+	nice -n 19 $(BIN)/python -m tests.warm_mjx
+	touch $(JAX_WARM)
+
 # everything the tests need: the installs and the core's build side by side
 setup: $(BUILD_DEPS)
-	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) $(STAMP_ALL) $(AOT) $(WARM)
+	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) $(STAMP_ALL) $(AOT) $(WARM) \
+		$(JAX_WARM)
 	@echo "set-up: done"
 
 # Main job: the reference against both tuned engines on the built-in chatter scene,

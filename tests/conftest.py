@@ -5,13 +5,13 @@ fails when any of them was skipped, since CI installs every extra (`make test`).
 
 JAX keeps what it compiles (the MJX engine's scans, ~10 s of CPU each) in .cache/jax at
 the repository's root, as numba keeps the core's functions in __pycache__: a test run
-after the first, and a second worker of the same run, load them instead of compiling."""
+after the first, and a second worker of the same run, load them instead of compiling.
+`make setup` fills it before the first run (tests/warm_mjx.py)."""
 
 from __future__ import annotations
 
 import importlib
 import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,10 +19,9 @@ import pytest
 from reference import quaternion as qt
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
 from tests.schedule import JAX_AT_COLLECTION, jax_loaded, ordered
+from tests.warm_mjx import JAX_CACHE_DIR
 
-os.environ.setdefault(
-    "JAX_COMPILATION_CACHE_DIR", str(Path(__file__).resolve().parents[1] / ".cache" / "jax")
-)
+os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", str(JAX_CACHE_DIR))
 
 
 def make_scene(

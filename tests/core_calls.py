@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from reference.core.dop853 import heun_euler_step, integrate_held
-from reference.core.held import held_rhs
+from reference.core.held import held_rhs, project_held
 from reference.core.jit import FALSE, ZERO, copy_into
 from reference.core.output import Output
 from reference.core.phases import NO_GRID
@@ -98,6 +98,23 @@ def held_rhs_as_the_loop_does(y, model, pts, idx, m, dy):
     """held.held_rhs: f(y) of the motion holding contacts idx[:m], into dy."""
     run = new_run()
     _held_rhs(y, model, pts, held_list(idx), m, run[0], dy)
+
+
+@njit
+def _project_held(y, model, pts, idx, m, run):
+    ws, state = run.scratch, run.state
+    copy_into(ws.y_chunk, y)
+    copy_into(state.active, idx)
+    projected = project_held(ws.y_chunk, model, pts, state.active, m, ws)
+    copy_into(y, ws.y_chunk)
+    return projected
+
+
+def project_held_as_the_loop_does(y, model, pts, idx, m):
+    """held.project_held: y (updated in place) projected onto the constraints of contacts
+    idx[:m]; False where its linear solve failed."""
+    run = new_run()
+    return _project_held(y, model, pts, held_list(idx), m, run[0])
 
 
 @njit

@@ -1,7 +1,8 @@
 """MJX adapter: the model is the `mujoco` engine's with diagexact off; float64 MJX steps
 as MuJoCo C does on that model; `mjx` and `mujoco` give the same impact on
 pentagon-bounce at dt = 1e-4 … 1e-9 while MuJoCo follows the reference; a vmapped batch
-gives the serial runs' trajectories.
+gives the serial runs' trajectories; the set-up's warm (tests/warm_mjx.py) compiles the
+programs these tests run.
 
 JAX is imported by the `mx` fixture, when the first of these tests runs, not when the file
 is collected: a test process with JAX loaded starts its sweep pools by spawn rather than
@@ -104,10 +105,8 @@ def test_mjx_and_mujoco_give_the_same_impact_while_mujoco_follows_the_reference(
         assert a.v_normal_post == pytest.approx(b.v_normal_post, rel=1e-3)
 
 
-def test_a_vmapped_batch_gives_the_serial_trajectories(bounce, mx):
-    scene, first = bounce
-    dt = 1e-4
-    short, _ = _before_impact(scene, first.t, dt)
+def _batch(short):
+    """The short run and the same spun 0.3 rad/s faster about the vertical."""
     y = _y0(short)
     spun = dataclasses.replace(
         short,
@@ -115,7 +114,14 @@ def test_a_vmapped_batch_gives_the_serial_trajectories(bounce, mx):
             short.initial, angular_velocity=tuple(np.array(y[10:13]) + [0.0, 0.0, 0.3])
         ),
     )
-    scenes = [short, spun]
+    return [short, spun]
+
+
+def test_a_vmapped_batch_gives_the_serial_trajectories(bounce, mx):
+    scene, first = bounce
+    dt = 1e-4
+    short, _ = _before_impact(scene, first.t, dt)
+    scenes = _batch(short)
     batch = mx.simulate_mjx_batch(scenes, dt=dt)
     for sc, b in zip(scenes, batch, strict=True):
         serial = mx.simulate_mjx(sc, dt)
@@ -154,3 +160,19 @@ def test_runs_of_other_lengths_share_the_compiled_scan_and_agree_step_for_step(b
     for field in ("position", "quaternion", "velocity"):
         assert np.array_equal(getattr(shorter, field), getattr(longer, field)[:n])
     assert np.array_equal(shorter.angular_velocity[:-1], longer.angular_velocity[: n - 1])
+
+
+def test_the_set_ups_warm_compiles_the_programs_these_tests_run(bounce, mx):
+    """tests/warm_mjx.py (run by `make setup`) compiles the same three programs as the
+    tests above, so that their workers load them from JAX's cache: after these tests'
+    runs (float64, float32, the batch), its runs add no compiled program."""
+    from tests.warm_mjx import compile_the_scans
+
+    scene, first = bounce
+    short, _ = _before_impact(scene, first.t, 1e-4)
+    mx.simulate_mjx(short, 1e-4)
+    mx.simulate_mjx(short, 1e-4, precision="float32")
+    mx.simulate_mjx_batch(_batch(short), dt=1e-4)
+    programs = set(mx._COMPILED)
+    compile_the_scans()
+    assert set(mx._COMPILED) == programs

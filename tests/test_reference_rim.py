@@ -13,6 +13,7 @@ from reference import quaternion as qt
 from reference.core.flight import flight_bounds, flight_constants
 from tests.conftest import core_model, make_scene
 from tests.oracle import flight as oracle_flight
+from tests.oracle import quaternion as oracle_qt
 from tests.oracle.body import BodyModel
 
 
@@ -40,8 +41,8 @@ def _oracle_heights(scene, y0, times):
     lowest, circle = [], []
     for s in times:
         y = oracle_flight.free_flight(fc, s)
-        lowest.append(np.min(body.rim_gaps(y)))
-        e3 = qt.body_axis(y[3:7])
+        lowest.append(body.rim_gaps(y).min())
+        e3 = oracle_qt.body_axis(y[3:7])
         circle.append(y[2] - scene.body.radius * math.hypot(e3[0], e3[1]))
     return np.array(lowest), np.array(circle)
 

@@ -9,10 +9,15 @@ in time on first use instead.  Why pycc: docs/development.md."""
 
 from __future__ import annotations
 
+import os
+import shutil
 import sys
+import tempfile
 import textwrap
+import threading
 import time
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from numba import from_dtype, types
@@ -68,9 +73,55 @@ def build(output_dir: Path = CORE_DIR) -> Path:
     cc.verbose = False
     for name, sig in signatures().items():
         cc.export(name, sig)(jit_function(name).py_func)
-    cc.compile()
+    compile_with_helpers_beside(cc)
     (output_dir / STAMP_FILE.name).write_text(source_stamp() + "\n")
     return output_dir / cc.output_file
+
+
+# what compile_with_helpers_beside uses of numba.pycc's CC (numba/pycc/cc.py, CC.compile)
+_CC_PARTS = ("_compile_object_files", "_compile_mixins", "_toolchain", "_get_extra_ldflags")
+
+
+def compile_with_helpers_beside(cc) -> None:
+    """`cc.compile()` with its two independent parts side by side.  numba.pycc compiles
+    the module's object file (numba and LLVM, in this process: nearly all the build)
+    and then the C helpers that numba's code needs (the C compiler, ~5 s), one after
+    the other, and links them.  Here the helpers compile in a thread whose compiler
+    processes run at the lowest priority, so that they take a core only when one is
+    idle (under `make setup` the other core installs the packages meanwhile, then
+    idles): they are ready by the time the object file is.  Where this numba's CC lacks
+    the parts used here, `cc.compile()` runs as it is."""
+    if not all(hasattr(cc, part) for part in _CC_PARTS):
+        cc.compile()
+        return
+    cc._toolchain.verbose = cc.verbose
+    build_dir = tempfile.mkdtemp(prefix=f"pycc-build-{cc.name}-")
+    try:
+        with ThreadPoolExecutor(1) as pool:
+            helpers = pool.submit(_at_lowest_priority, cc._compile_mixins, build_dir)
+            objects, exports = cc._compile_object_files(build_dir)
+            objects += helpers.result()
+        cc._toolchain.link_shared(
+            os.path.join(cc.output_dir, cc.output_file),
+            objects,
+            cc._toolchain.get_python_libraries(),
+            cc._toolchain.get_python_library_dirs(),
+            export_symbols=exports,
+            extra_ldflags=cc._get_extra_ldflags(),
+        )
+    finally:
+        shutil.rmtree(build_dir, ignore_errors=True)
+
+
+def _at_lowest_priority(fn, *args):
+    """fn(*args) with this thread (and the processes it starts) at nice 19, where the
+    system allows it (Linux: a thread's nice value is its own, and its children
+    inherit it)."""
+    try:
+        os.setpriority(os.PRIO_PROCESS, threading.get_native_id(), 19)
+    except (AttributeError, OSError):  # no setpriority (Windows), or a thread id refused
+        pass
+    return fn(*args)
 
 
 def signature_counts() -> dict[str, int]:

@@ -1,0 +1,60 @@
+"""Fill JAX's compilation cache with the programs MJX's tests compile:
+`python -m tests.warm_mjx` (run by `make setup`, at the lowest priority, on the core the
+installs leave idle while the reference's core builds on the other).
+
+tests/test_engine_mjx.py runs pentagon-bounce through three compiled scans of
+engines.mjx.CHUNK_STEPS steps: float64, float32, and float64 vmapped over a batch of two
+scenes.  JAX compiles each on its first use (XLA, several seconds of CPU each) and keeps it
+in JAX_CACHE_DIR; the tests set that directory too (tests/conftest.py), so that their
+workers load the three programs instead of compiling them.  A program depends on the
+model's structure, the precision and the batch's size, not on the time step or the
+initial state: the short runs below compile the same three.  The runs' results are
+discarded; without the [mjx] extra nothing is done."""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import os
+import sys
+import time
+from pathlib import Path
+
+JAX_CACHE_DIR = Path(__file__).resolve().parents[1] / ".cache" / "jax"
+SCENE = "pentagon-bounce"  # MJX's tests' scene
+DT = 1e-4
+
+
+def compile_the_scans() -> float:
+    """Run SCENE briefly in float64, float32 and as a batch of two scenes (the batch
+    test's size); returns the seconds JAX spent compiling or loading the programs."""
+    from engines import mjx
+    from reference.scenes import as_scene
+
+    scene = as_scene(SCENE).with_run(t_end=10 * DT)
+    spun = dataclasses.replace(
+        scene, initial=dataclasses.replace(scene.initial, angular_velocity=(0.0, 0.0, 0.3))
+    )
+    runs = [mjx.simulate_mjx(scene, DT), mjx.simulate_mjx(scene, DT, precision="float32")]
+    runs += mjx.simulate_mjx_batch([scene, spun], dt=DT)[:1]
+    return sum(run.stats["compile_time_s"] for run in runs)
+
+
+def main() -> int:
+    if importlib.util.find_spec("jax") is None or importlib.util.find_spec("mujoco.mjx") is None:
+        print("MJX's scans: no [mjx] extra installed, nothing to compile", flush=True)
+        return 0
+    os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", str(JAX_CACHE_DIR))
+    print("compiling MJX's scans for its tests into JAX's cache ...", flush=True)
+    t0 = time.perf_counter()
+    seconds = compile_the_scans()
+    print(
+        f"MJX's scans are in JAX's cache ({seconds:.0f} s compiling, "
+        f"{time.perf_counter() - t0:.0f} s in all)",
+        flush=True,
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
