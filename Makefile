@@ -29,35 +29,43 @@ $(BUILD_DEPS): pyproject.toml
 	@echo "set-up 1/3: a virtual environment in $(VENV) and what the reference's compiled core"
 	@echo "  is built with ($(BUILD_REQUIRES)); Python:"
 	@echo "  $(PYTHON)"
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --progress-bar off --no-compile $(BUILD_REQUIRES)
+	$(PYTHON) -m venv $(if $(PIP_CAN_TARGET),--without-pip) $(VENV)
+	$(VENV_PIP) install --progress-bar off --no-compile $(BUILD_REQUIRES)
 	touch $(BUILD_DEPS)
 
-# Beside the core's build, not before it: pip brought up to date (the venv's own pip
-# installs the build's requirements, the current one the packages), and the build's
-# requirements byte-compiled (pip's --no-compile above: 7.5 of their 12.7 s install)
-BESIDE_BUILD := $(BIN)/pip install --progress-bar off --upgrade pip && \
+# The venv is made without pip (ensurepip takes 6 s, all on the set-up's longest path)
+# where the system's pip can install into it (`pip --python`, pip >= 22.3): that pip
+# installs the build's requirements and then, beside the build, the venv's own pip.
+# (asked once per make, when first needed)
+PIP_CAN_TARGET = $(eval PIP_CAN_TARGET := $(shell $(PYTHON) -m pip --python $(PYTHON) --version \
+	> /dev/null 2>&1 && echo yes))$(PIP_CAN_TARGET)
+VENV_PIP = $(if $(PIP_CAN_TARGET),$(PYTHON) -m pip --python $(BIN)/python,$(BIN)/pip)
+
+# Beside the core's build, not before it: the venv's own pip, current (installed, or
+# brought up to date), and the build's requirements byte-compiled (pip's --no-compile
+# above: 7.5 of their 12.7 s install)
+BESIDE_BUILD = $(VENV_PIP) install --progress-bar off --upgrade pip && \
 	$(BIN)/python -m compileall -q $(VENV)/lib
 
 # the package and its core dependencies: the demo's needs
 $(STAMP): $(BUILD_DEPS)
-	@echo "set-up 2/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
-	@echo "  beside step 3/3"
+	@echo "set-up 3/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
+	@echo "  beside step 2/3"
 	$(BESIDE_BUILD)
 	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e .
 	touch $(STAMP)
 
 # every extra ([all]: drake, dart, mjx, dask) and the dev tools
 $(STAMP_ALL): $(BUILD_DEPS)
-	@echo "set-up 2/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
-	@echo "  (2.5 GB in all), beside step 3/3"
+	@echo "set-up 3/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
+	@echo "  (2.5 GB in all), beside step 2/3"
 	$(BESIDE_BUILD)
 	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e '.[all,dev]'
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
-	@echo "set-up 3/3: the reference's compiled core (about 2–3 min on one core, beside step"
-	@echo "  2/3; rebuilt when its sources change)"
+	@echo "set-up 2/3: the reference's compiled core (about 2–3 min on one core, beside step"
+	@echo "  3/3; rebuilt when its sources change)"
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)
 
@@ -66,7 +74,7 @@ $(AOT): $(BUILD_DEPS) $(CORE)
 # build still runs
 PACKAGES ?= $(STAMP)
 $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
-	@echo "set-up 2/3, then: the linear model's kernel into numba's cache"
+	@echo "set-up 3/3, then: the linear model's kernel into numba's cache"
 	$(BIN)/python -m reference.warm
 	touch $(WARM)
 
@@ -76,13 +84,13 @@ $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
 # core (XLA compiles on several threads); the tests' workers then load the programs
 JAX_WARM := $(VENV)/.jax-warm
 $(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
-	@echo "set-up 2/3, last: MJX's scans, for its tests, into JAX's cache"
+	@echo "set-up 3/3, last: MJX's scans, for its tests, into JAX's cache"
 	nice -n 19 $(BIN)/python -m tests.warm_mjx
 	touch $(JAX_WARM)
 
 # everything the tests need: the installs and the core's build side by side
 setup: $(BUILD_DEPS)
-	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) $(STAMP_ALL) $(AOT) $(WARM) \
+	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) $(AOT) $(STAMP_ALL) $(WARM) \
 		$(JAX_WARM)
 	@echo "set-up: done"
 
@@ -90,7 +98,7 @@ setup: $(BUILD_DEPS)
 # with a rerun recording of all three side by side (--force: the demo's own recording is
 # replaced when the demo runs again).
 demo: $(BUILD_DEPS)
-	@$(MAKE) --no-print-directory -j2 $(STAMP) $(AOT) $(WARM)
+	@$(MAKE) --no-print-directory -j2 $(AOT) $(STAMP) $(WARM)
 	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
 		--record recordings/triangle-chatter.rrd --force
 

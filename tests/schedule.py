@@ -18,7 +18,7 @@ while the other idles.  `ordered` sorts the collected tests so that:
 4. then the rest, as collected.
 
 FILE_SECONDS holds the files that take ≥ 2 s, their CPU seconds (the test process's and
-its children's) on a 2-core machine, numba's cache as `make setup` leaves it
+its children's) on a 2-core machine, numba's and JAX's caches as `make setup` leaves them
 (docs/performance.md, "Where the tests' time goes").  The order only moves time between
 the workers: any order gives the same results."""
 
@@ -30,34 +30,29 @@ from pathlib import Path
 import pytest
 
 FILE_SECONDS = {
-    "test_engine_mjx.py": 34.6,
-    "test_oracle.py": 22.2,
-    "test_readme_commands.py": 16.3,
-    "test_report.py": 13.8,
-    "test_sweep.py": 13.1,
-    "test_reference_search.py": 11.9,
-    "test_reference_rim.py": 10.5,
-    "test_paper_figures.py": 7.9,
-    "test_signals.py": 7.5,
-    "test_core_flight.py": 6.0,
-    "test_reference_end.py": 5.9,
-    "test_fuzz_cli.py": 5.4,
-    "test_sweep_parts.py": 4.8,
-    "test_law_registry.py": 4.6,
-    "test_compliant_law.py": 4.3,
-    "test_core_contacts.py": 4.2,
-    "test_docs_figures.py": 3.7,
-    "test_core_roots.py": 3.5,
-    "test_engine_drake.py": 3.4,
-    "test_write_faults.py": 3.1,
-    "test_oracle_bumpy.py": 3.0,
-    "test_core_dop853.py": 3.0,
-    "test_horizon.py": 2.8,
-    "test_linear_impact_laws.py": 2.6,
-    "test_extras_ci.py": 2.5,
-    "test_cli.py": 2.3,
-    "test_sweep_heal.py": 2.1,
-    "test_cli_inputs.py": 2.1,
+    "test_oracle.py": 20.9,
+    "test_report.py": 16.1,
+    "test_readme_commands.py": 11.6,
+    "test_sweep.py": 10.7,
+    "test_engine_mjx.py": 9.7,
+    "test_reference_search.py": 9.3,
+    "test_paper_figures.py": 9.0,
+    "test_reference_rim.py": 7.4,
+    "test_signals.py": 7.3,
+    "test_fuzz_cli.py": 6.5,
+    "test_core_flight.py": 5.5,
+    "test_reference_end.py": 5.0,
+    "test_sweep_parts.py": 4.2,
+    "test_law_registry.py": 4.0,
+    "test_docs_figures.py": 3.2,
+    "test_engine_drake.py": 2.8,
+    "test_core_roots.py": 2.7,
+    "test_core_contacts.py": 2.4,
+    "test_write_faults.py": 2.4,
+    "test_compliant_law.py": 2.4,
+    "test_linear_impact_laws.py": 2.3,
+    "test_horizon.py": 2.2,
+    "test_core_dop853.py": 2.1,
 }
 
 # files whose tests start process pools in the test process

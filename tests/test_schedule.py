@@ -35,11 +35,11 @@ def test_pool_files_come_before_jax_files_and_the_longest_first():
     ]
     assert [item.nodeid for item in ordered(items)] == [
         "tests/test_sweep.py::a",  # pools, 10.7 s
-        "tests/test_sweep_heal.py::a",  # pools, 2 s
+        "tests/test_sweep_heal.py::a",  # pools, under 2 s: unlisted
         "tests/test_engine_mjx.py::a",
-        "tests/test_oracle.py::a",  # 20.3 s, its tests in their order
+        "tests/test_oracle.py::a",  # 20.9 s, its tests in their order
         "tests/test_oracle.py::b",
-        "tests/test_report.py::a",  # 18.9 s
+        "tests/test_report.py::a",  # 16.1 s
         "tests/test_short.py::a",  # unlisted: as collected
         "tests/test_short.py::b",
     ]
