@@ -176,5 +176,20 @@ def require_extra(module: str, extra: str):
         pytest.fail(f"{reason}; CI installs every extra (`make test`): {exc}", pytrace=False)
 
 
+def require_aot_core():
+    """The reference's ahead-of-time module, fresh (reference.compiled.fresh_aot_module);
+    the test is skipped without it, and fails under CI=true, where `make test` builds it:
+    a failed build (the loop then compiled just in time) does not pass unseen."""
+    from reference.compiled import fresh_aot_module
+
+    module = fresh_aot_module()
+    if module is None:
+        reason = "no fresh ahead-of-time core (python -m reference.core.aot builds it)"
+        if _ci():
+            pytest.fail(f"{reason}; CI builds it (`make test`)", pytrace=False)
+        pytest.skip(reason)
+    return module
+
+
 def _ci() -> bool:
     return os.environ.get("CI", "").strip().lower() in ("true", "1", "yes")

@@ -14,7 +14,7 @@ import engines.mujoco as M
 import engines.pybullet as PB
 from harness.cli import build_parser, main
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, SceneError
-from tests.conftest import make_scene
+from tests.conftest import make_scene, require_aot_core
 
 
 class StopAt:
@@ -155,10 +155,7 @@ def test_simulate_with_the_compiled_core_imports_no_heavy_library():
     import sys
     from pathlib import Path
 
-    from reference.compiled import fresh_aot_module
-
-    if fresh_aot_module() is None:
-        pytest.skip("no fresh ahead-of-time core (python -m reference.core.aot builds it)")
+    require_aot_core()
     code = (
         "import sys\n"
         "from harness.cli import main\n"
