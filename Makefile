@@ -36,7 +36,8 @@ $(BUILD_DEPS): pyproject.toml
 # The venv is made without pip (ensurepip takes 6 s, all on the set-up's longest path)
 # where the system's pip can install into it (`pip --python`, pip >= 22.3): that pip
 # installs the build's requirements and then, beside the build, the venv's own pip.
-# (asked once per make, when first needed)
+# (asked once, when first needed, and passed on to the make that runs the steps side by
+# side: asked there, make would ask while the core's build waits to start)
 PIP_CAN_TARGET = $(eval PIP_CAN_TARGET := $(shell $(PYTHON) -m pip --python $(PYTHON) --version \
 	> /dev/null 2>&1 && echo yes))$(PIP_CAN_TARGET)
 VENV_PIP = $(if $(PIP_CAN_TARGET),$(PYTHON) -m pip --python $(BIN)/python,$(BIN)/pip)
@@ -90,15 +91,15 @@ $(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
 
 # everything the tests need: the installs and the core's build side by side
 setup: $(BUILD_DEPS)
-	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) $(AOT) $(STAMP_ALL) $(WARM) \
-		$(JAX_WARM)
+	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) PIP_CAN_TARGET=$(PIP_CAN_TARGET) \
+		$(AOT) $(STAMP_ALL) $(WARM) $(JAX_WARM)
 	@echo "set-up: done"
 
 # Main job: the reference against both tuned engines on the built-in chatter scene,
 # with a rerun recording of all three side by side (--force: the demo's own recording is
 # replaced when the demo runs again).
 demo: $(BUILD_DEPS)
-	@$(MAKE) --no-print-directory -j2 $(AOT) $(STAMP) $(WARM)
+	@$(MAKE) --no-print-directory -j2 PIP_CAN_TARGET=$(PIP_CAN_TARGET) $(AOT) $(STAMP) $(WARM)
 	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
 		--record recordings/triangle-chatter.rrd --force
 
