@@ -23,6 +23,7 @@ from reference.scene import InitialState
 from reference.scenes import as_scene
 from reference.simulate import simulate
 from tests.conftest import require_extra
+from tests.warm_mjx import batch_of_two, compile_the_scans
 
 STEPS = 60  # steps of each short run: 30 before the first impact, 30 after
 
@@ -105,23 +106,11 @@ def test_mjx_and_mujoco_give_the_same_impact_while_mujoco_follows_the_reference(
         assert a.v_normal_post == pytest.approx(b.v_normal_post, rel=1e-3)
 
 
-def _batch(short):
-    """The short run and the same spun 0.3 rad/s faster about the vertical."""
-    y = _y0(short)
-    spun = dataclasses.replace(
-        short,
-        initial=dataclasses.replace(
-            short.initial, angular_velocity=tuple(np.array(y[10:13]) + [0.0, 0.0, 0.3])
-        ),
-    )
-    return [short, spun]
-
-
 def test_a_vmapped_batch_gives_the_serial_trajectories(bounce, mx):
     scene, first = bounce
     dt = 1e-4
     short, _ = _before_impact(scene, first.t, dt)
-    scenes = _batch(short)
+    scenes = batch_of_two(short)
     batch = mx.simulate_mjx_batch(scenes, dt=dt)
     for sc, b in zip(scenes, batch, strict=True):
         serial = mx.simulate_mjx(sc, dt)
@@ -162,17 +151,18 @@ def test_runs_of_other_lengths_share_the_compiled_scan_and_agree_step_for_step(b
     assert np.array_equal(shorter.angular_velocity[:-1], longer.angular_velocity[: n - 1])
 
 
-def test_the_set_ups_warm_compiles_the_programs_these_tests_run(bounce, mx):
+def test_the_set_ups_warm_compiles_the_programs_these_tests_run(bounce, mx, monkeypatch):
     """tests/warm_mjx.py (run by `make setup`) compiles the same three programs as the
-    tests above, so that their workers load them from JAX's cache: after these tests'
-    runs (float64, float32, the batch), its runs add no compiled program."""
-    from tests.warm_mjx import compile_the_scans
-
+    tests above, so that their workers load them from JAX's cache: the programs of these
+    tests' runs (float64, float32, the batch) and of the warm's, each counted from an
+    empty table of compiled programs, are the same."""
     scene, first = bounce
     short, _ = _before_impact(scene, first.t, 1e-4)
+    monkeypatch.setattr(mx, "_COMPILED", {})
     mx.simulate_mjx(short, 1e-4)
     mx.simulate_mjx(short, 1e-4, precision="float32")
-    mx.simulate_mjx_batch(_batch(short), dt=1e-4)
+    mx.simulate_mjx_batch(batch_of_two(short), dt=1e-4)
     programs = set(mx._COMPILED)
+    monkeypatch.setattr(mx, "_COMPILED", {})
     compile_the_scans()
-    assert set(mx._COMPILED) == programs
+    assert set(mx._COMPILED) == programs and len(programs) == 3
