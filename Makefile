@@ -48,12 +48,21 @@ VENV_PIP = $(if $(PIP_CAN_TARGET),$(PYTHON) -m pip --python $(BIN)/python,$(BIN)
 BESIDE_BUILD = $(VENV_PIP) install --progress-bar off --upgrade pip && \
 	$(BIN)/python -m compileall -q $(VENV)/lib
 
+# The packages are installed without their bytecode (pip's --no-compile): pip would
+# byte-compile all 12,000 of their modules (42 CPU-s); the ~3,000 that the project and
+# its tests import are compiled by the set-up's last step (tests/warm_bytecode.py) or
+# where first imported, and their bytecode written then (WRITE_BYTECODE: also where the
+# environment sets PYTHONDONTWRITEBYTECODE), so that every later process reads them
+# compiled.
+LAZY_BYTECODE := --no-compile
+WRITE_BYTECODE := env -u PYTHONDONTWRITEBYTECODE
+
 # the package and its core dependencies: the demo's needs
 $(STAMP): $(BUILD_DEPS)
 	@echo "set-up 3/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
 	@echo "  beside step 2/3"
 	$(BESIDE_BUILD)
-	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e .
+	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off $(LAZY_BYTECODE) -e .
 	touch $(STAMP)
 
 # every extra ([all]: drake, dart, mjx, dask) and the dev tools
@@ -61,7 +70,7 @@ $(STAMP_ALL): $(BUILD_DEPS)
 	@echo "set-up 3/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
 	@echo "  (2.5 GB in all), beside step 2/3"
 	$(BESIDE_BUILD)
-	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off -e '.[all,dev]'
+	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off $(LAZY_BYTECODE) -e '.[all,dev]'
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
@@ -76,8 +85,16 @@ $(AOT): $(BUILD_DEPS) $(CORE)
 PACKAGES ?= $(STAMP)
 $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
 	@echo "set-up 3/3, then: the linear model's kernel into numba's cache"
-	$(BIN)/python -m reference.warm
+	$(WRITE_BYTECODE) $(BIN)/python -m reference.warm
 	touch $(WARM)
+
+# the bytecode of the installed modules the project and its tests import, written once
+# the packages are in, so that the tests' processes do not each compile them
+BYTECODE_WARM := $(VENV)/.bytecode
+$(BYTECODE_WARM): $(STAMP_ALL) tests/warm_bytecode.py
+	@echo "set-up 3/3, then: the bytecode of the modules the tests import"
+	$(WRITE_BYTECODE) nice -n 19 $(BIN)/python -m tests.warm_bytecode
+	touch $(BYTECODE_WARM)
 
 # JAX's compilation cache (.cache/jax) filled with the three programs MJX's tests compile
 # (tests/warm_mjx.py): on the core that the installs and the linear kernel leave idle
@@ -86,13 +103,13 @@ $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
 JAX_WARM := $(VENV)/.jax-warm
 $(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
 	@echo "set-up 3/3, last: MJX's scans, for its tests, into JAX's cache"
-	nice -n 19 $(BIN)/python -m tests.warm_mjx
+	$(WRITE_BYTECODE) nice -n 19 $(BIN)/python -m tests.warm_mjx
 	touch $(JAX_WARM)
 
 # everything the tests need: the installs and the core's build side by side
 setup: $(BUILD_DEPS)
 	@$(MAKE) --no-print-directory -j2 PACKAGES=$(STAMP_ALL) PIP_CAN_TARGET=$(PIP_CAN_TARGET) \
-		$(AOT) $(STAMP_ALL) $(WARM) $(JAX_WARM)
+		$(AOT) $(STAMP_ALL) $(BYTECODE_WARM) $(WARM) $(JAX_WARM)
 	@echo "set-up: done"
 
 # Main job: the reference against both tuned engines on the built-in chatter scene,
@@ -100,7 +117,7 @@ setup: $(BUILD_DEPS)
 # replaced when the demo runs again).
 demo: $(BUILD_DEPS)
 	@$(MAKE) --no-print-directory -j2 PIP_CAN_TARGET=$(PIP_CAN_TARGET) $(AOT) $(STAMP) $(WARM)
-	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
+	$(WRITE_BYTECODE) $(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
 		--record recordings/triangle-chatter.rrd --force
 
 # every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
@@ -116,11 +133,11 @@ demo: $(BUILD_DEPS)
 # them (pool-starting files before JAX's, then the longest first).
 TEST_WORKERS ?= auto
 test: setup
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile \
+	$(WRITE_BYTECODE) $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile \
 		--no-loadscope-reorder
 
 test-slow: setup
-	env -u PYTHONDONTWRITEBYTECODE $(BIN)/python -m pytest -m slow
+	$(WRITE_BYTECODE) $(BIN)/python -m pytest -m slow
 
 lint: $(STAMP_ALL)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
