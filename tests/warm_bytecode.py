@@ -16,7 +16,6 @@ left to be compiled where it is used."""
 from __future__ import annotations
 
 import ast
-import importlib
 import sys
 import time
 from pathlib import Path
@@ -54,12 +53,15 @@ def project_imports(root: Path = ROOT) -> list[str]:
 
 
 def import_each(names: list[str]) -> tuple[int, int]:
-    """Import each module (its bytecode written as it is compiled); returns (modules
-    imported, names that are not importable modules here)."""
+    """Import each module (its bytecode written as it is compiled; a banner a library
+    prints from C, such as PyBullet's, kept off the terminal: engines.quiet); returns
+    (modules imported, names that are not importable modules here)."""
+    from engines.quiet import quiet_import
+
     missing = 0
     for name in names:
         try:
-            importlib.import_module(name)
+            quiet_import(name)
         except Exception:  # an attribute, not a module; an extra not installed; no GPU
             missing += 1
     return len(names) - missing, missing
@@ -70,9 +72,9 @@ def main() -> int:
     before = len(sys.modules)
     imported, missing = import_each(project_imports())
     print(
-        f"bytecode of {len(sys.modules) - before} installed modules written "
-        f"({imported} named by the sources, {missing} names not importable here; "
-        f"{time.perf_counter() - t0:.0f} s)",
+        f"{len(sys.modules) - before} modules imported, their bytecode written where "
+        f"missing ({imported} named by the sources, {missing} names not importable "
+        f"here; {time.perf_counter() - t0:.0f} s)",
         flush=True,
     )
     return 0
