@@ -50,10 +50,10 @@ BESIDE_BUILD = $(VENV_PIP) install --progress-bar off --upgrade pip && \
 
 # The packages are installed without their bytecode (pip's --no-compile): pip would
 # byte-compile all 12,000 of their modules (42 CPU-s); the ~3,000 that the project and
-# its tests import are compiled by the set-up's last step (tests/warm_bytecode.py) or
-# where first imported, and their bytecode written then (WRITE_BYTECODE: also where the
-# environment sets PYTHONDONTWRITEBYTECODE), so that every later process reads them
-# compiled.
+# its tests import are compiled by the set-up step after the install
+# (tests/warm_bytecode.py) or where first imported, and their bytecode written then
+# (WRITE_BYTECODE: also where the environment sets PYTHONDONTWRITEBYTECODE), so that
+# every later process reads them compiled.
 LAZY_BYTECODE := --no-compile
 WRITE_BYTECODE := env -u PYTHONDONTWRITEBYTECODE
 
@@ -117,8 +117,8 @@ setup: $(BUILD_DEPS)
 # replaced when the demo runs again).
 demo: $(BUILD_DEPS)
 	@$(MAKE) --no-print-directory -j2 PIP_CAN_TARGET=$(PIP_CAN_TARGET) $(AOT) $(STAMP) $(WARM)
-	$(WRITE_BYTECODE) $(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet --engine linear \
-		--record recordings/triangle-chatter.rrd --force
+	$(WRITE_BYTECODE) $(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet \
+		--engine linear --record recordings/triangle-chatter.rrd --force
 
 # every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
 # engine whose extra is missing has its tests skipped with the reason, and under CI=true
