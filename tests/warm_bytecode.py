@@ -1,6 +1,7 @@
 """Write the bytecode of the installed modules that the project and its tests import:
-`python -m tests.warm_bytecode` (run by `make setup`, last, on the core the installs
-leave idle while the reference's core builds on the other).
+`python -m tests.warm_bytecode` (run by `make setup` right after the install, at the
+lowest priority, on the core the install leaves idle while the reference's core builds
+on the other).
 
 `make setup` installs the packages without their bytecode (pip's --no-compile): pip
 would compile all of their ~12,000 modules, most of which nothing here imports (their own
