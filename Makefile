@@ -1,5 +1,10 @@
 # Two entry points (see README): `make demo` and `make test`.
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
+# Every command here writes Python's bytecode, also where the environment sets
+# PYTHONDONTWRITEBYTECODE: the set-up's steps, the demo and the test suite start hundreds
+# of Python processes, and each then reads the modules (and pytest its rewritten tests)
+# compiled once instead of compiling them again.
+unexport PYTHONDONTWRITEBYTECODE
 VENV   := .venv
 BIN    := $(VENV)/bin
 # what is installed: the core (the demo's needs: reference, harness, MuJoCo, PyBullet) and,
@@ -51,11 +56,9 @@ BESIDE_BUILD = $(VENV_PIP) install --progress-bar off --upgrade pip && \
 # The packages are installed without their bytecode (pip's --no-compile): pip would
 # byte-compile all 12,000 of their modules (42 CPU-s); the ~3,000 that the project and
 # its tests import are compiled by the set-up step after the install
-# (tests/warm_bytecode.py) or where first imported, and their bytecode written then
-# (WRITE_BYTECODE: also where the environment sets PYTHONDONTWRITEBYTECODE), so that
-# every later process reads them compiled.
+# (tests/warm_bytecode.py) or where first imported, and their bytecode written then, so
+# that every later process reads them compiled.
 LAZY_BYTECODE := --no-compile
-WRITE_BYTECODE := env -u PYTHONDONTWRITEBYTECODE
 
 # the package and its core dependencies: the demo's needs
 $(STAMP): $(BUILD_DEPS)
@@ -85,7 +88,7 @@ $(AOT): $(BUILD_DEPS) $(CORE)
 PACKAGES ?= $(STAMP)
 $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
 	@echo "set-up 3/3, then: the linear model's kernel into numba's cache"
-	$(WRITE_BYTECODE) $(BIN)/python -m reference.warm
+	$(BIN)/python -m reference.warm
 	touch $(WARM)
 
 # the bytecode of the installed modules the project and its tests import, written once
@@ -93,7 +96,7 @@ $(WARM): $(PACKAGES) $(CORE) $(LINEAR)
 BYTECODE_WARM := $(VENV)/.bytecode
 $(BYTECODE_WARM): $(STAMP_ALL) tests/warm_bytecode.py
 	@echo "set-up 3/3, then: the bytecode of the modules the tests import"
-	$(WRITE_BYTECODE) nice -n 19 $(BIN)/python -m tests.warm_bytecode
+	nice -n 19 $(BIN)/python -m tests.warm_bytecode
 	touch $(BYTECODE_WARM)
 
 # JAX's compilation cache (.cache/jax) filled with the three programs MJX's tests compile
@@ -103,7 +106,7 @@ $(BYTECODE_WARM): $(STAMP_ALL) tests/warm_bytecode.py
 JAX_WARM := $(VENV)/.jax-warm
 $(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
 	@echo "set-up 3/3, last: MJX's scans, for its tests, into JAX's cache"
-	$(WRITE_BYTECODE) nice -n 19 $(BIN)/python -m tests.warm_mjx
+	nice -n 19 $(BIN)/python -m tests.warm_mjx
 	touch $(JAX_WARM)
 
 # everything the tests need: the installs and the core's build side by side
@@ -117,15 +120,12 @@ setup: $(BUILD_DEPS)
 # replaced when the demo runs again).
 demo: $(BUILD_DEPS)
 	@$(MAKE) --no-print-directory -j2 PIP_CAN_TARGET=$(PIP_CAN_TARGET) $(AOT) $(STAMP) $(WARM)
-	$(WRITE_BYTECODE) $(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet \
+	$(BIN)/harness compare triangle-chatter --engine mujoco --engine pybullet \
 		--engine linear --record recordings/triangle-chatter.rrd --force
 
 # every engine's tests, on every core (pytest-xdist; TEST_WORKERS=1: one process); an
 # engine whose extra is missing has its tests skipped with the reason, and under CI=true
 # (.ci/run) they fail instead (tests/conftest.py)
-# The suite starts hundreds of Python processes (every worker, every CLI test): byte-code
-# caches are written even where the environment sets PYTHONDONTWRITEBYTECODE, so that each
-# process reads the project's modules (and pytest its rewritten tests) compiled once.
 # --dist loadfile: each test file runs whole on one worker, so that its module-scoped
 # fixtures (the report's documents), the compilations its tests share (the integrator's
 # tests, MJX's scans) and its imports are done once, not once per worker;
@@ -133,11 +133,11 @@ demo: $(BUILD_DEPS)
 # them (pool-starting files before JAX's, then the longest first).
 TEST_WORKERS ?= auto
 test: setup
-	$(WRITE_BYTECODE) $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile \
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) --dist loadfile \
 		--no-loadscope-reorder
 
 test-slow: setup
-	$(WRITE_BYTECODE) $(BIN)/python -m pytest -m slow
+	$(BIN)/python -m pytest -m slow
 
 lint: $(STAMP_ALL)
 	$(BIN)/ruff check . && $(BIN)/ruff format --check .
