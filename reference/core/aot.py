@@ -9,6 +9,7 @@ in time on first use instead.  Why pycc: docs/development.md."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import sys
@@ -59,7 +60,17 @@ def build(output_dir: Path = CORE_DIR) -> Path:
     """Compile the module into output_dir and write its stamp there; returns the
     module's path.  Any module already there goes first: a failed build leaves none (of
     older sources) behind."""
+    return build_counting(output_dir)[0]
+
+
+def build_counting(output_dir: Path = CORE_DIR) -> tuple[Path, dict[str, int]]:
+    """`build`, and the signatures compiled of each core function (`signature_counts`).
+    numba compiles the functions under the exported ones to LLVM IR only
+    (reference.core.ir_only: no machine code, no on-disk cache), where this numba
+    allows it."""
     from reference.compiled import STAMP_FILE, jit_function, source_stamp
+
+    from . import ir_only
 
     output_dir.mkdir(parents=True, exist_ok=True)
     for old in [*output_dir.glob("_aot*.so"), output_dir / STAMP_FILE.name]:
@@ -73,9 +84,11 @@ def build(output_dir: Path = CORE_DIR) -> Path:
     cc.verbose = False
     for name, sig in signatures().items():
         cc.export(name, sig)(jit_function(name).py_func)
-    compile_with_helpers_beside(cc)
+    with ir_only.ir_only() if ir_only.available() else contextlib.nullcontext():
+        compile_with_helpers_beside(cc)
+        counts = signature_counts()
     (output_dir / STAMP_FILE.name).write_text(source_stamp() + "\n")
-    return output_dir / cc.output_file
+    return output_dir / cc.output_file, counts
 
 
 # what compile_with_helpers_beside uses of numba.pycc's CC (numba/pycc/cc.py, CC.compile)
@@ -126,8 +139,9 @@ def _at_lowest_priority(fn, *args):
 
 def signature_counts() -> dict[str, int]:
     """The number of signatures numba has compiled of each core function compiled in
-    this process, by "module.function" (after `build`: everything under the exported
-    functions; a function inlined by numba, jit.hot_inline, has none of its own)."""
+    this process, by "module.function" (at the end of `build_counting`: everything under
+    the exported functions; a function inlined by numba, jit.hot_inline, has none of its
+    own)."""
     from numba.core.registry import CPUDispatcher
 
     counts = {}
@@ -160,14 +174,14 @@ def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
     t0 = time.perf_counter()
     print("building the reference's event loop ahead of time (about 2–3 min) ...", flush=True)
     try:
-        path = build(output_dir)
+        path, counts = build_counting(output_dir)
     except Exception as exc:  # any failure: the loop is compiled just in time instead
         reason = " ".join(f"{type(exc).__name__}: {exc}".split())  # one line
         print(f"ahead-of-time build skipped ({reason}); the loop will be compiled just in "
               "time on first use", file=sys.stderr)  # fmt: skip
         return None
     print(f"built {path.name} in {time.perf_counter() - t0:.0f} s", flush=True)
-    print(textwrap.fill(repeated_signatures(signature_counts()), 100), flush=True)
+    print(textwrap.fill(repeated_signatures(counts), 100), flush=True)
     return path
 
 
