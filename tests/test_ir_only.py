@@ -1,5 +1,6 @@
-"""reference.core.ir_only: numba compiling to LLVM IR without machine code or cache, for
-the ahead-of-time build; afterwards, functions compile and run as usual."""
+"""reference.core.ir_only: the functions it selects compile to LLVM IR without machine
+code or cache entry, the others as usual; afterwards, everything compiles and runs as
+usual."""
 
 import importlib.util
 import sys
@@ -9,6 +10,7 @@ from numba import float64, njit
 from numba.core.compiler_lock import global_compiler_lock
 
 from reference.core import ir_only
+from reference.core.aot import in_loop_layers
 
 pytestmark = pytest.mark.skipif(not ir_only.available(), reason="numba lacks the parts")
 
@@ -18,6 +20,10 @@ from numba import njit
 @njit(cache=True)
 def cube(x):
     return x * x * x
+
+@njit(cache=True)
+def square(x):
+    return x * x
 """
 
 
@@ -35,6 +41,14 @@ def _fresh_functions():
     return half, half_plus_one
 
 
+def _everything(module, qualname):
+    return True
+
+
+def _halves(module, qualname):
+    return qualname.endswith(".half")
+
+
 def _machine_code(function):
     """The object code numba's MCJIT generated for the function's one overload (numba
     keeps it, CodeLibrary._compiled_object, to cache it), None if none was generated."""
@@ -42,9 +56,9 @@ def _machine_code(function):
     return result.library._compiled_object
 
 
-def test_inside_functions_compile_to_ir_only_and_their_entry_points_raise_type_error():
+def test_selected_functions_compile_to_ir_only_and_their_entry_points_raise_type_error():
     half, half_plus_one = _fresh_functions()
-    with ir_only.ir_only():
+    with ir_only.ir_only(_everything):
         half_plus_one.compile((float64,))
         (result,) = half_plus_one.overloads.values()
         with global_compiler_lock:  # finalised, its callee linked in, as pycc does
@@ -56,46 +70,61 @@ def test_inside_functions_compile_to_ir_only_and_their_entry_points_raise_type_e
     assert "half_plus_one" in ir and "fmul" in ir and "fadd" in ir
 
 
-def test_on_leaving_the_overloads_are_dropped_and_calls_compile_as_usual():
+def test_a_caller_left_out_runs_with_its_selected_callee_linked_in():
     half, half_plus_one = _fresh_functions()
-    with ir_only.ir_only():
+    with ir_only.ir_only(_halves):
+        assert half_plus_one(3.0) == 2.5
+        assert _machine_code(half_plus_one) is not None
+        assert _machine_code(half) is None  # not generated with its caller's either
+        with pytest.raises(TypeError):
+            half(3.0)
+
+
+def test_on_leaving_the_selected_overloads_are_dropped_and_calls_compile_as_usual():
+    half, half_plus_one = _fresh_functions()
+    with ir_only.ir_only(_halves):
         half_plus_one.compile((float64,))
-    assert not half_plus_one.overloads and not half.overloads
-    assert half_plus_one(3.0) == 2.5
-    assert _machine_code(half_plus_one) is not None
+    assert not half.overloads and len(half_plus_one.overloads) == 1
+    assert half(3.0) == 1.5 and half_plus_one(3.0) == 2.5
+    assert _machine_code(half) is not None
 
 
-def test_inside_numbas_cache_is_not_written_and_outside_it_is(tmp_path, monkeypatch):
-    (tmp_path / "cubed.py").write_text(CACHED_SOURCE)
-    monkeypatch.syspath_prepend(str(tmp_path))
-    spec = importlib.util.spec_from_file_location("cubed", tmp_path / "cubed.py")
+def test_inside_only_the_functions_left_out_are_cached(tmp_path, monkeypatch):
+    (tmp_path / "powers.py").write_text(CACHED_SOURCE)
+    spec = importlib.util.spec_from_file_location("powers", tmp_path / "powers.py")
     module = importlib.util.module_from_spec(spec)
-    monkeypatch.setitem(sys.modules, "cubed", module)
+    monkeypatch.setitem(sys.modules, "powers", module)
     spec.loader.exec_module(module)
     cache_dir = tmp_path / "__pycache__"
-    with ir_only.ir_only():
+    with ir_only.ir_only(lambda _, qualname: qualname == "cube"):
         module.cube.compile((float64,))
-    assert not list(cache_dir.glob("cubed.cube-*.nbc"))
+        module.square.compile((float64,))
+    assert not list(cache_dir.glob("powers.cube-*.nbc"))
+    assert list(cache_dir.glob("powers.square-*.nbc"))
     assert module.cube(2.0) == 8.0
-    assert list(cache_dir.glob("cubed.cube-*.nbc"))
+    assert list(cache_dir.glob("powers.cube-*.nbc"))
 
 
 def test_the_replaced_methods_are_numbas_own_again_after_leaving():
     from numba.core import caching, codegen, cpu, dispatcher
 
-    methods = [
-        codegen.JITCodeLibrary._finalize_specific,
-        cpu.CPUContext.get_executable,
-        caching.Cache.load_overload,
-        caching.Cache.save_overload,
-        dispatcher.Dispatcher.add_overload,
-    ]
-    with ir_only.ir_only():
-        assert cpu.CPUContext.get_executable is not methods[1]
-    assert methods == [
-        codegen.JITCodeLibrary._finalize_specific,
-        cpu.CPUContext.get_executable,
-        caching.Cache.load_overload,
-        caching.Cache.save_overload,
-        dispatcher.Dispatcher.add_overload,
-    ]
+    def methods():
+        return [
+            codegen.JITCPUCodegen._add_module,
+            cpu.CPUContext.get_executable,
+            caching.Cache.load_overload,
+            caching.Cache.save_overload,
+            dispatcher.Dispatcher.add_overload,
+        ]
+
+    before = methods()
+    with ir_only.ir_only(_everything):
+        assert all(a is not b for a, b in zip(methods(), before, strict=True))
+    assert methods() == before
+
+
+def test_the_build_selects_the_loops_layers_and_not_what_tests_load_from_the_cache():
+    assert in_loop_layers("reference.core.phases", "contact_step")
+    assert in_loop_layers("reference.core.loop", "run_steps")
+    for module in ("impact_laws", "compliant", "dop853", "search", "held", "contacts"):
+        assert not in_loop_layers(f"reference.core.{module}", "f")

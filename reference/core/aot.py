@@ -56,6 +56,22 @@ def signatures() -> dict:
     }
 
 
+# The event loop's own layers: only the loop calls their functions, through the module,
+# so the build compiles them to LLVM IR only (reference.core.ir_only), without the
+# machine code and numba-cache entries that nothing would load.  The functions of the
+# other core modules keep both: the linear kernel's warm-up and the tests load them
+# from numba's cache (the laws, the integrator, the flight search, the helpers tests
+# call as the loop does).
+LOOP_LAYERS = frozenset(
+    f"reference.core.{name}" for name in ("loop", "phases", "events", "law_event", "multi_impact")
+)
+
+
+def in_loop_layers(module: str, qualname: str) -> bool:
+    """Whether a function compiled by the build is one of the loop's own layers."""
+    return module in LOOP_LAYERS
+
+
 def build(output_dir: Path = CORE_DIR) -> Path:
     """Compile the module into output_dir and write its stamp there; returns the
     module's path.  Any module already there goes first: a failed build leaves none (of
@@ -65,8 +81,7 @@ def build(output_dir: Path = CORE_DIR) -> Path:
 
 def build_counting(output_dir: Path = CORE_DIR) -> tuple[Path, dict[str, int]]:
     """`build`, and the signatures compiled of each core function (`signature_counts`).
-    numba compiles the functions under the exported ones to LLVM IR only
-    (reference.core.ir_only: no machine code, no on-disk cache), where this numba
+    The loop's own layers are compiled to LLVM IR only (LOOP_LAYERS), where this numba
     allows it."""
     from reference.compiled import STAMP_FILE, jit_function, source_stamp
 
@@ -84,7 +99,8 @@ def build_counting(output_dir: Path = CORE_DIR) -> tuple[Path, dict[str, int]]:
     cc.verbose = False
     for name, sig in signatures().items():
         cc.export(name, sig)(jit_function(name).py_func)
-    with ir_only.ir_only() if ir_only.available() else contextlib.nullcontext():
+    only_ir = ir_only.available()
+    with ir_only.ir_only(in_loop_layers) if only_ir else contextlib.nullcontext():
         compile_with_helpers_beside(cc)
         counts = signature_counts()
     (output_dir / STAMP_FILE.name).write_text(source_stamp() + "\n")

@@ -1,17 +1,21 @@
-"""numba compiling to LLVM IR only, for the ahead-of-time build (`reference.core.aot`).
+"""numba compiling chosen functions to LLVM IR only, for the ahead-of-time build
+(`reference.core.aot`, which chooses the event loop's own layers: `aot.LOOP_LAYERS`).
 
 numba.pycc compiles each function that an exported function calls as numba's own
-just-in-time function: numba lowers it to LLVM IR and optimises it (the IR that pycc
-links into the module), and then also generates its machine code for this process (LLVM's
-MCJIT) and writes both to numba's on-disk cache.  The build never runs that machine code
-and never reads that cache entry: generating them took 35 s of a 149 s build
-(docs/performance.md, "The core's build").  `ir_only()` leaves both out.
+just-in-time function: lowered to LLVM IR and optimised (the IR that pycc links into the
+module), then also turned into machine code for the build's process (LLVM's MCJIT) and
+written, with that machine code, to numba's on-disk cache.  The build runs none of that
+machine code.  Of the cache entries, the linear kernel's warm-up and the tests load
+those of the laws, the integrator, the flight search and the helpers tests call as the
+loop does; those of the loop's own layers, which only the loop calls, nothing loads.
+`ir_only(selected)` leaves out the machine code and the cache entry of the functions it
+is given (docs/performance.md, "The core's build", has the measurements).
 
-One difference follows, measured: MCJIT's code generation rewrites a library's IR in place
-(LLVM's CodeGenPrepare) before numba links it into its callers, so with machine code
-the module is built from callees' IR after that rewrite, and here from the IR as numba's
-optimiser left it.  59 of the module's 930 functions come out a few hundred bytes apart
-in size; the module's speed is the same (paired benchmark, docs/performance.md)."""
+A chosen function's library is never handed to MCJIT, whose code generation would also
+rewrite its IR in place (LLVM's CodeGenPrepare) before its callers link it, so the module
+is built from that function's IR as numba's optimiser left it: the module differs from
+one built with machine code in the sizes of some functions, and its speed is measured
+against it (docs/performance.md)."""
 
 from __future__ import annotations
 
@@ -28,7 +32,7 @@ def _numba_parts():
     except ImportError:
         return None
     parts = {
-        (codegen.JITCodeLibrary, "_finalize_specific"),
+        (codegen.JITCPUCodegen, "_add_module"),
         (cpu.CPUContext, "get_executable"),
         (caching.Cache, "load_overload"),
         (caching.Cache, "save_overload"),
@@ -53,43 +57,80 @@ _RAISING_ENTRY = ctypes.cast(ctypes.pythonapi.PyObject_Call, ctypes.c_void_p).va
 
 
 @contextmanager
-def ir_only():
-    """Inside: numba's just-in-time libraries are finalised without machine code, each
-    compiled function's entry point raises TypeError when called, and numba's on-disk
-    cache is neither read nor written (what is compiled depends on the sources alone).
-    On leaving, the overloads compiled inside are dropped, so that a later call
-    compiles its function as usual.  Raises RuntimeError where this numba lacks the
-    parts replaced (`available()`)."""
+def ir_only(selected):
+    """Inside, for each function that numba compiles and `selected(module, qualname)`
+    accepts: its library is finalised without machine code, its entry point raises
+    TypeError when called, and it is not written to numba's on-disk cache.  The other
+    functions compile as usual, with machine code, and are cached (a selected callee's
+    IR linked into theirs).  Nothing is read from numba's cache inside: what is compiled
+    depends on the sources alone.  On leaving, the overloads of the selected functions
+    are dropped, so that a later call compiles them as usual.  Raises RuntimeError where
+    this numba lacks the parts replaced (`available()`)."""
     parts = _numba_parts()
     if parts is None:
         raise RuntimeError("this numba lacks the internals that ir_only replaces")
+    ir_libraries = set()  # the libraries of the selected functions
+    placeholders = set()  # the dispatchers holding a placeholder entry point
+    with _replaced(_replacements(parts, selected, ir_libraries, placeholders)):
+        try:
+            yield
+        finally:
+            for function in placeholders:
+                function._reset_overloads()
+
+
+def _replacements(parts, selected, ir_libraries, placeholders) -> dict:
+    """numba's methods that `ir_only` replaces, by (class, name), and their
+    replacements; `ir_libraries` and `placeholders` are filled as functions compile."""
     codegen, cpu, caching, dispatcher, dynfunc = parts
-    compiled = set()
+    add_module = codegen.JITCPUCodegen._add_module
+    get_executable = cpu.CPUContext.get_executable
+    save_overload = caching.Cache.save_overload
     add_overload = dispatcher.Dispatcher.add_overload
 
-    def recording_add_overload(self, cres):
-        compiled.add(self)
-        add_overload(self, cres)
+    def add_module_for_machine_code(self, module):
+        # a selected library's module is kept from MCJIT, which generates the machine
+        # code of every module it holds when a library is finalised
+        if not any(module is library._final_module for library in ir_libraries):
+            return add_module(self, module)
+        return None
 
     def placeholder_executable(self, library, fndesc, env):
+        if not selected(fndesc.modname, fndesc.qualname):
+            return get_executable(self, library, fndesc, env)
+        ir_libraries.add(library)
         name = fndesc.qualname.split(".")[-1]
         doc = "compiled to LLVM IR only (reference.core.ir_only): not callable"
         return dynfunc.make_function(
             fndesc.lookup_module(), name, doc, _RAISING_ENTRY, env, (library,)
         )
 
-    replaced = {
-        (codegen.JITCodeLibrary, "_finalize_specific"): lambda self: None,
+    def save_with_machine_code(self, sig, data):
+        if data.library not in ir_libraries:
+            save_overload(self, sig, data)
+
+    def recording_add_overload(self, cres):
+        if cres.library in ir_libraries:
+            placeholders.add(self)
+        add_overload(self, cres)
+
+    return {
+        (codegen.JITCPUCodegen, "_add_module"): add_module_for_machine_code,
         (cpu.CPUContext, "get_executable"): placeholder_executable,
         (caching.Cache, "load_overload"): lambda self, sig, target_context: None,
-        (caching.Cache, "save_overload"): lambda self, sig, data: None,
+        (caching.Cache, "save_overload"): save_with_machine_code,
         (dispatcher.Dispatcher, "add_overload"): recording_add_overload,
     }
-    # each class's own method (None: the method is inherited, and put back by deleting
-    # the replacement)
-    originals = {(cls, name): vars(cls).get(name) for cls, name in replaced}
+
+
+@contextmanager
+def _replaced(methods: dict):
+    """The classes' methods replaced inside (`methods`: (class, name) → function), and
+    put back on leaving: a class's own method set again, an inherited one uncovered by
+    deleting the replacement."""
+    originals = {(cls, name): vars(cls).get(name) for cls, name in methods}
     try:
-        for (cls, name), method in replaced.items():
+        for (cls, name), method in methods.items():
             setattr(cls, name, method)
         yield
     finally:
@@ -98,5 +139,3 @@ def ir_only():
                 delattr(cls, name)
             else:
                 setattr(cls, name, method)
-        for function in compiled:
-            function._reset_overloads()
