@@ -77,7 +77,7 @@ $(STAMP_ALL): $(BUILD_DEPS)
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
-	@echo "set-up 2/3: the reference's compiled core (about 2–3 min on one core, beside step"
+	@echo "set-up 2/3: the reference's compiled core (about 2 min on one core, beside step"
 	@echo "  3/3; rebuilt when its sources change)"
 	$(BIN)/python -m reference.core.aot
 	touch $(AOT)

@@ -188,7 +188,7 @@ def build_or_explain(output_dir: Path = CORE_DIR) -> Path | None:
     numba.pycc) one line on stderr says so and None is returned: the loop is then
     compiled just in time on first use."""
     t0 = time.perf_counter()
-    print("building the reference's event loop ahead of time (about 2–3 min) ...", flush=True)
+    print("building the reference's event loop ahead of time (about 2 min) ...", flush=True)
     try:
         path, counts = build_counting(output_dir)
     except Exception as exc:  # any failure: the loop is compiled just in time instead
