@@ -5,6 +5,7 @@ usual."""
 import importlib.util
 import sys
 
+import numba.core.config
 import pytest
 from numba import float64, njit
 from numba.core.compiler_lock import global_compiler_lock
@@ -90,19 +91,20 @@ def test_on_leaving_the_selected_overloads_are_dropped_and_calls_compile_as_usua
 
 
 def test_inside_only_the_functions_left_out_are_cached(tmp_path, monkeypatch):
+    cache_dir = tmp_path / "numba-cache"  # numba's cache for this test alone
+    monkeypatch.setattr(numba.core.config, "CACHE_DIR", str(cache_dir))
     (tmp_path / "powers.py").write_text(CACHED_SOURCE)
     spec = importlib.util.spec_from_file_location("powers", tmp_path / "powers.py")
     module = importlib.util.module_from_spec(spec)
     monkeypatch.setitem(sys.modules, "powers", module)
     spec.loader.exec_module(module)
-    cache_dir = tmp_path / "__pycache__"
     with ir_only.ir_only(lambda _, qualname: qualname == "cube"):
         module.cube.compile((float64,))
         module.square.compile((float64,))
-    assert not list(cache_dir.glob("powers.cube-*.nbc"))
-    assert list(cache_dir.glob("powers.square-*.nbc"))
+    assert not list(cache_dir.rglob("powers.cube-*.nbc"))
+    assert list(cache_dir.rglob("powers.square-*.nbc"))
     assert module.cube(2.0) == 8.0
-    assert list(cache_dir.glob("powers.cube-*.nbc"))
+    assert list(cache_dir.rglob("powers.cube-*.nbc"))
 
 
 def test_the_replaced_methods_are_numbas_own_again_after_leaving():
