@@ -9,7 +9,7 @@ machine code.  Of the cache entries, the linear kernel's warm-up and the tests l
 those of the laws, the integrator, the flight search and the helpers tests call as the
 loop does; those of the loop's own layers, which only the loop calls, nothing loads.
 `ir_only(selected)` leaves out the machine code and the cache entry of the functions it
-is given (docs/performance.md, "The core's build", has the measurements).
+is given (docs/performance.md, "Where the set-up's time goes", has the measurements).
 
 A chosen function's library is never handed to MCJIT, whose code generation would also
 rewrite its IR in place (LLVM's CodeGenPrepare) before its callers link it, so the module
