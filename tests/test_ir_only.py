@@ -1,8 +1,9 @@
-"""reference.core.ir_only: the functions it selects compile to LLVM IR without machine
-code or cache entry, the others as usual; afterwards, everything compiles and runs as
-usual."""
+"""reference.core.ir_only: the functions it selects compile to LLVM IR without module
+passes, machine code or cache entry, the others as usual; afterwards, everything
+compiles and runs as usual."""
 
 import importlib.util
+import re
 import sys
 
 import numba.core.config
@@ -71,6 +72,32 @@ def test_selected_functions_compile_to_ir_only_and_their_entry_points_raise_type
     assert "half_plus_one" in ir and "fmul" in ir and "fadd" in ir
 
 
+# a call to `half` (numba's mangled name: ...4half followed by its ABI tag or arguments)
+CALL_TO_HALF = re.compile(r"call [^\n]*@\"?_ZN[^ \"(]*4half[BE]")
+
+
+def _finalised_ir(function):
+    """The LLVM IR of the function's one overload, finalised (its callees linked in), as
+    pycc links it."""
+    (result,) = function.overloads.values()
+    with global_compiler_lock:
+        result.library._ensure_finalized()
+    return result.library.get_llvm_str()
+
+
+def test_a_selected_library_is_linked_unoptimised_and_optimised_where_it_is_linked():
+    half, half_plus_one = _fresh_functions()
+    with ir_only.ir_only(_everything):
+        half_plus_one.compile((float64,))
+        ir_only_ir = _finalised_ir(half_plus_one)
+    assert CALL_TO_HALF.search(ir_only_ir)  # no module passes: `half` not inlined
+    half, half_plus_one = _fresh_functions()
+    with ir_only.ir_only(_halves):  # the caller left out is optimised as usual
+        half_plus_one.compile((float64,))
+        optimised_ir = _finalised_ir(half_plus_one)
+    assert not CALL_TO_HALF.search(optimised_ir) and "fmul" in optimised_ir
+
+
 def test_a_caller_left_out_runs_with_its_selected_callee_linked_in():
     half, half_plus_one = _fresh_functions()
     with ir_only.ir_only(_halves):
@@ -117,6 +144,7 @@ def test_the_replaced_methods_are_numbas_own_again_after_leaving():
             caching.Cache.load_overload,
             caching.Cache.save_overload,
             dispatcher.Dispatcher.add_overload,
+            codegen.CPUCodeLibrary._optimize_final_module,
         ]
 
     before = methods()
