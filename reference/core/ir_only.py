@@ -30,25 +30,21 @@ from contextlib import contextmanager
 
 
 def _numba_parts():
-    """numba's classes that `ir_only` replaces methods of, or None where this numba
-    lacks one of them (numba/core/codegen.py, cpu.py, caching.py, dispatcher.py)."""
+    """numba's modules whose classes `ir_only` replaces methods of, or None where this
+    numba lacks one of the methods (`_replacements` names them: numba/core/codegen.py,
+    cpu.py, caching.py, dispatcher.py) or `_dynfunc.make_function`."""
     try:
         from numba import _dynfunc
         from numba.core import caching, codegen, cpu, dispatcher
     except ImportError:
         return None
-    parts = {
-        (codegen.JITCPUCodegen, "_add_module"),
-        (cpu.CPUContext, "get_executable"),
-        (caching.Cache, "load_overload"),
-        (caching.Cache, "save_overload"),
-        (dispatcher.Dispatcher, "add_overload"),
-        (codegen.CPUCodeLibrary, "_optimize_final_module"),
-    }
-    has_all = all(hasattr(cls, name) for cls, name in parts)
-    if not (has_all and hasattr(_dynfunc, "make_function")):
+    parts = codegen, cpu, caching, dispatcher, _dynfunc
+    try:  # the replacements read the methods they replace
+        replaced = _replacements(parts, lambda module, qualname: False, set(), set())
+    except AttributeError:
         return None
-    return codegen, cpu, caching, dispatcher, _dynfunc
+    has_all = all(hasattr(cls, name) for cls, name in replaced)
+    return parts if has_all and hasattr(_dynfunc, "make_function") else None
 
 
 def available() -> bool:
