@@ -78,16 +78,17 @@ def as_grid(stats: pd.DataFrame, column: str, config: SweepConfig) -> np.ndarray
 def chatter_regions(n: int, gammas: np.ndarray, rhos: np.ndarray):
     """(cc, pcc) boolean arrays [i_rho, i_gamma]: the CC and PCC properties of the
     gravity-free n-gon (ρ must be > 0)."""
-    from reference.linear.chatter import cc_property, pcc_property
+    from reference.linear import chatter
     from reference.linear.model import LinearModel
 
-    cc = np.zeros((len(rhos), len(gammas)), dtype=bool)
-    pcc = np.zeros_like(cc)
-    for i, r in enumerate(rhos):
-        for j, g in enumerate(gammas):
-            m = LinearModel.polygon(n, float(r), float(g))
-            cc[i, j] = cc_property(m)
-            pcc[i, j] = pcc_property(m)
+    models = [LinearModel.polygon(n, float(r), float(g)) for r in rhos for g in gammas]
+    # the eigenvalues of all the cells in one call each (cc_property and pcc_property,
+    # one model at a time, are the same predicates on the same matrices)
+    lam_cc = np.linalg.eigvals(np.array([chatter.cc_matrix(m) for m in models]))
+    lam_pcc = np.linalg.eigvals(np.array([chatter.pcc_matrix(m) for m in models]))
+    shape = (len(rhos), len(gammas))
+    cc = np.array([chatter.cc_of_eigenvalues(lam) for lam in lam_cc]).reshape(shape)
+    pcc = np.array([chatter.pcc_of_eigenvalues(lam) for lam in lam_pcc]).reshape(shape)
     return cc, pcc
 
 

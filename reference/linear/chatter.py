@@ -52,19 +52,37 @@ def _visible_block(model: LinearModel, A: np.ndarray) -> np.ndarray:
     return A
 
 
-def cc_property(model: LinearModel) -> bool:
-    """Dominant eigenvalue of R⁻¹U0 real and positive (eq. CCtriangle)."""
-    lam = np.linalg.eigvals(_visible_block(model, chatter_matrix(model)))
+def cc_matrix(model: LinearModel) -> np.ndarray:
+    """The matrix whose eigenvalues decide CC: R⁻¹U0 (its visible block for the rod)."""
+    return _visible_block(model, chatter_matrix(model))
+
+
+def cc_of_eigenvalues(lam: np.ndarray) -> bool:
+    """CC from the eigenvalues of `cc_matrix`: the dominant one (largest modulus, ties
+    included) real and positive (eq. CCtriangle)."""
     top = lam[np.argmax(np.abs(lam))]
     big = np.abs(lam) >= np.abs(top) * (1 - 1e-12)
     return bool(all(abs(z.imag) <= 1e-12 * abs(z) and z.real > 0 for z in lam[big]))
 
 
+def cc_property(model: LinearModel) -> bool:
+    """Dominant eigenvalue of R⁻¹U0 real and positive (eq. CCtriangle)."""
+    return cc_of_eigenvalues(np.linalg.eigvals(cc_matrix(model)))
+
+
+def pcc_matrix(model: LinearModel) -> np.ndarray:
+    """U0 R U0 R⁻¹, the map of two alternating impacts (eq. PCCtriangle)."""
+    return model.U(0) @ model.R @ model.U(0) @ model.R.T
+
+
+def pcc_of_eigenvalues(lam: np.ndarray) -> bool:
+    """PCC from the eigenvalues of `pcc_matrix`: none of them complex."""
+    return bool(np.all(np.abs(lam.imag) <= 1e-12 * np.maximum(np.abs(lam), TINY)))
+
+
 def pcc_property(model: LinearModel) -> bool:
     """U0 R U0 R⁻¹ has no complex eigenvalues (eq. PCCtriangle)."""
-    A = model.U(0) @ model.R @ model.U(0) @ model.R.T
-    lam = np.linalg.eigvals(A)
-    return bool(np.all(np.abs(lam.imag) <= 1e-12 * np.maximum(np.abs(lam), TINY)))
+    return pcc_of_eigenvalues(np.linalg.eigvals(pcc_matrix(model)))
 
 
 def rod_betas(rho: float, gamma: float) -> tuple[float, float] | None:

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -182,20 +183,31 @@ class LinearModel:
     def n_contacts(self) -> int:
         return len(self.points)
 
-    @property
+    # The matrices below are formed once per model: the analyses ask for them thousands
+    # of times.  They stay writeable (a read-only array is another type to the compiled
+    # kernel, which takes F and Θ), and no caller writes into them.
+    @cached_property
     def F(self) -> np.ndarray:
         return contact_vectors(self.points)
 
-    @property
+    @cached_property
     def theta(self) -> np.ndarray:
         return theta_diag(self.mass, self.inertia)
 
-    @property
+    @cached_property
     def R(self) -> np.ndarray:
         return rotation(self.symmetry)
 
     def U(self, k: int = 0) -> np.ndarray:
-        return impact_matrix(self.F[k], self.theta, self.restitution)
+        k = int(k)
+        if k not in self._impact_matrices:
+            self._impact_matrices[k] = impact_matrix(self.F[k], self.theta, self.restitution)
+        return self._impact_matrices[k]
+
+    @cached_property
+    def _impact_matrices(self) -> dict[int, np.ndarray]:
+        """U(k) of the contacts asked for so far, by k."""
+        return {}
 
     def a_contact(self, k: int = 0) -> np.ndarray:
         return contact_acceleration(self.F[k], self.theta, self.mass, self.gravity)
@@ -207,7 +219,7 @@ class LinearModel:
     def energy(self, q, p) -> float:
         return float(energy(np.asarray(q), np.asarray(p), self.theta, self.mass, self.gravity))
 
-    @property
+    @cached_property
     def rank(self) -> int:
         """Rank of the contact vectors: 3 for n >= 3 (three contacts down ⇒ q = 0), 2 for
         the rod (φx, the roll about the rod's own axis, is invisible to its contacts)."""

@@ -50,14 +50,22 @@ def first_root_lower_bound(g: float, g1: float, g2: float, K: float, B: float) -
     """First positive root of max(P2, P3) (see module doc); inf if none; 0 if g ≤ 0."""
     if g <= 0.0:
         return 0.0
-    # P2: g + g1 δ − K δ²/2; positive root in the cancellation-free branch for g1's sign
+    d2 = quadratic_root_lower_bound(g, g1, K)
+    c2, c3 = 0.5 * g2, -B / 6.0
+    if g + d2 * (g1 + d2 * (c2 + d2 * c3)) <= 0.0:
+        return d2  # P3(0) > 0 ≥ P3(d2): P3's first root is at most d2
+    return max(d2, _first_root_cubic(g, g1, c2, c3))
+
+
+def quadratic_root_lower_bound(g: float, g1: float, K: float) -> float:
+    """First positive root of P2(δ) = g + g1 δ − K δ²/2 (inf if none; 0 if g ≤ 0), in
+    the cancellation-free branch for g1's sign: a lower bound on max(P2, P3)'s."""
+    if g <= 0.0:
+        return 0.0
     if K > 0.0:
         sq = math.sqrt(g1 * g1 + 2.0 * K * g)
-        d2 = (g1 + sq) / K if g1 >= 0.0 else 2.0 * g / (sq - g1)
-    else:
-        d2 = g / -g1 if g1 < 0.0 else math.inf
-    d3 = _first_root_cubic(g, g1, 0.5 * g2, -B / 6.0)
-    return max(d2, d3)
+        return (g1 + sq) / K if g1 >= 0.0 else 2.0 * g / (sq - g1)
+    return g / -g1 if g1 < 0.0 else math.inf
 
 
 def _first_root_cubic(c0: float, c1: float, c2: float, c3: float) -> float:
@@ -108,18 +116,24 @@ def _first_root_cubic(c0: float, c1: float, c2: float, c3: float) -> float:
 def _bracketed_root(p, dp, lo: float, hi: float, rel: float = 1e-3) -> float:
     """A point below the root of a monotone p on [lo, hi] with p(lo) > 0 ≥ p(hi), within
     `rel` of it: a safe step needs no more (near a real contact the quadratic bound
-    already gives the Newton-like step)."""
+    already gives the Newton-like step).
+
+    Newton steps from the last point, a bisection wherever a step leaves the bracket.
+    Newton approaches the root from one side; once its step is below rel/4 of the point,
+    a probe rel/4 across the root closes the bracket."""
+    x, px = lo, p(lo)
     for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        d = dp(mid)
-        if d != 0.0:
-            nxt = mid - p(mid) / d
-            if lo < nxt < hi:
-                mid = nxt
-        if p(mid) > 0.0:
-            lo = mid
-        else:
-            hi = mid
+        d = dp(x)
+        nxt = x - px / d if d != 0.0 else math.nan
+        if not lo < nxt < hi:
+            nxt = 0.5 * (lo + hi)
+        small = abs(nxt - x) <= 0.25 * rel * nxt
+        x, px = nxt, p(nxt)
+        lo, hi = (x, hi) if px > 0.0 else (lo, x)
+        if small and hi - lo > rel * hi:
+            probe = x * (1.0 + 0.25 * rel) if px > 0.0 else x * (1.0 - 0.25 * rel)
+            if lo < probe < hi:
+                lo, hi = (probe, hi) if p(probe) > 0.0 else (lo, probe)
         if hi - lo <= rel * hi:
             break
     return lo
@@ -203,15 +217,7 @@ def next_flight_event(
         landing = np.flatnonzero(touching & (jet.rate <= jet.rate_noise) & (jet.accel < 0))
         if landing.size:
             return FlightEvent(s, tuple(int(k) for k in landing), y, it, kind="activation")
-        step = math.inf
-        for k in range(len(jet.gap)):
-            g = jet.gap[k]
-            if g <= jet.noise[k]:
-                # touching and not approaching: bound from the positive-rate side
-                g = max(g, 0.0) + jet.noise[k]
-            d = first_root_lower_bound(g, jet.rate[k], jet.accel[k], K, B)
-            if d < step:
-                step = d
+        step = _safe_step(jet, K, B)
         # a contact resting with g′≈0 and g″≈0 would stall: leave at roundoff pace
         step = max(step, 1e-15 * max(s, 1e-300))
         if s + step >= horizon:
@@ -219,6 +225,21 @@ def next_flight_event(
         s += step
         y = free_flight(fc, s)
     raise RuntimeError("event search did not converge (max_iter)")
+
+
+def _safe_step(jet: GapJet, K: float, B: float) -> float:
+    """The smallest first_root_lower_bound over the contacts.  They are visited in the
+    order of their quadratic bounds, which bound first_root_lower_bound from below: once
+    one is at least the smallest step found, no later contact can lower it."""
+    # touching and not approaching: bound from the positive-rate side
+    gaps = np.where(jet.gap <= jet.noise, np.maximum(jet.gap, 0.0) + jet.noise, jet.gap)
+    lower = [quadratic_root_lower_bound(g, r, K) for g, r in zip(gaps, jet.rate, strict=True)]
+    step = math.inf
+    for k in sorted(range(len(lower)), key=lower.__getitem__):
+        if lower[k] >= step:
+            break
+        step = min(step, first_root_lower_bound(gaps[k], jet.rate[k], jet.accel[k], K, B))
+    return step
 
 
 def _polish(model, fc, s, jet: GapJet, hit: np.ndarray, horizon: float, it: int) -> FlightEvent:
