@@ -220,10 +220,36 @@ def _main(argv: list[str] | None) -> int:
         status = signals.exit_status() or signals.EXIT_INTERRUPTED
         print(SIGNAL_LINES[status], file=sys.stderr)
         return status
-    except Exception:
+    except Exception as exc:
+        lack = memory_exhaustion(exc)
+        if lack is not None:  # e.g. a shared library that cannot be mapped (ulimit -v)
+            print(f"harness: error: out of memory: {one_line(str(lack))}", file=sys.stderr)
+            return 2
         traceback.print_exc()
         print("harness: internal failure (traceback above)", file=sys.stderr)
         return 1
+
+
+# what the loader (dlopen) and the C library say when memory or address space runs out
+_NO_MEMORY_TEXTS = ("failed to map segment", "cannot allocate memory")
+
+
+def memory_exhaustion(exc: BaseException) -> OSError | None:
+    """The OSError in `exc`'s chain of causes that says memory ran out (errno ENOMEM, or
+    the loader unable to map a shared library into the address space), or None.  A
+    library that fails to load this way is often reported by its importer as another
+    OSError ("could not find/load …") raised while handling the first."""
+    seen: set[int] = set()
+    cause: BaseException | None = exc
+    while cause is not None and id(cause) not in seen:
+        seen.add(id(cause))
+        text = str(cause).lower()
+        if isinstance(cause, OSError) and (
+            cause.errno == errno.ENOMEM or any(t in text for t in _NO_MEMORY_TEXTS)
+        ):
+            return cause
+        cause = cause.__cause__ or cause.__context__
+    return None
 
 
 def _silence_stdout() -> None:
