@@ -207,10 +207,6 @@ def _main(argv: list[str] | None) -> int:
     except (BadInput, SceneError, OutputError) as exc:
         print(f"harness: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
-    except MemoryError as exc:  # pyarrow's ArrowMemoryError too
-        detail = f": {one_line(str(exc))}" if str(exc) else ""
-        print(f"harness: error: out of memory{detail}; nothing written", file=sys.stderr)
-        return 2
     except SystemExit as exc:  # --help, --version: argparse exits
         return exc.code if isinstance(exc.code, int) else 0
     except Terminated:
@@ -222,8 +218,9 @@ def _main(argv: list[str] | None) -> int:
         return status
     except Exception as exc:
         lack = memory_exhaustion(exc)
-        if lack is not None:  # e.g. a shared library that cannot be mapped (ulimit -v)
-            print(f"harness: error: out of memory: {one_line(str(lack))}", file=sys.stderr)
+        if lack is not None:
+            detail = f": {one_line(str(lack))}" if str(lack) else ""
+            print(f"harness: error: out of memory{detail}; nothing written", file=sys.stderr)
             return 2
         traceback.print_exc()
         print("harness: internal failure (traceback above)", file=sys.stderr)
@@ -234,9 +231,10 @@ def _main(argv: list[str] | None) -> int:
 _NO_MEMORY_TEXTS = ("failed to map segment", "cannot allocate memory")
 
 
-def memory_exhaustion(exc: BaseException) -> OSError | None:
-    """The OSError in `exc`'s chain of causes that says memory ran out (errno ENOMEM, or
-    the loader unable to map a shared library into the address space), or None.  A
+def memory_exhaustion(exc: BaseException) -> BaseException | None:
+    """The exception in `exc`'s chain of causes that says memory ran out, or None: a
+    MemoryError (pyarrow's ArrowMemoryError too), or an OSError with errno ENOMEM or the
+    loader unable to map a shared library into the address space (`ulimit -v`).  A
     library that fails to load this way is often reported by its importer as another
     OSError ("could not find/load …") raised while handling the first."""
     seen: set[int] = set()
@@ -244,8 +242,9 @@ def memory_exhaustion(exc: BaseException) -> OSError | None:
     while cause is not None and id(cause) not in seen:
         seen.add(id(cause))
         text = str(cause).lower()
-        if isinstance(cause, OSError) and (
-            cause.errno == errno.ENOMEM or any(t in text for t in _NO_MEMORY_TEXTS)
+        if isinstance(cause, MemoryError) or (
+            isinstance(cause, OSError)
+            and (cause.errno == errno.ENOMEM or any(t in text for t in _NO_MEMORY_TEXTS))
         ):
             return cause
         cause = cause.__cause__ or cause.__context__

@@ -48,9 +48,13 @@ def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray, idx=None) -> GapJ
 
 def first_root_lower_bound(g: float, g1: float, g2: float, K: float, B: float) -> float:
     """First positive root of max(P2, P3) (see module doc); inf if none; 0 if g ≤ 0."""
+    return _raised_by_cubic(quadratic_root_lower_bound(g, g1, K), g, g1, g2, B)
+
+
+def _raised_by_cubic(d2: float, g: float, g1: float, g2: float, B: float) -> float:
+    """max(d2, P3's first positive root), d2 being P2's (0 if g ≤ 0)."""
     if g <= 0.0:
         return 0.0
-    d2 = quadratic_root_lower_bound(g, g1, K)
     c2, c3 = 0.5 * g2, -B / 6.0
     if g + d2 * (g1 + d2 * (c2 + d2 * c3)) <= 0.0:
         return d2  # P3(0) > 0 ≥ P3(d2): P3's first root is at most d2
@@ -229,8 +233,8 @@ def next_flight_event(
 
 def _safe_step(jet: GapJet, K: float, B: float) -> float:
     """The smallest first_root_lower_bound over the contacts.  They are visited in the
-    order of their quadratic bounds, which bound first_root_lower_bound from below: once
-    one is at least the smallest step found, no later contact can lower it."""
+    order of their quadratic roots, which bound it from below: once one is at least the
+    smallest step found, no later contact can lower it."""
     # touching and not approaching: bound from the positive-rate side
     gaps = np.where(jet.gap <= jet.noise, np.maximum(jet.gap, 0.0) + jet.noise, jet.gap)
     lower = [quadratic_root_lower_bound(g, r, K) for g, r in zip(gaps, jet.rate, strict=True)]
@@ -238,7 +242,7 @@ def _safe_step(jet: GapJet, K: float, B: float) -> float:
     for k in sorted(range(len(lower)), key=lower.__getitem__):
         if lower[k] >= step:
             break
-        step = min(step, first_root_lower_bound(gaps[k], jet.rate[k], jet.accel[k], K, B))
+        step = min(step, _raised_by_cubic(lower[k], gaps[k], jet.rate[k], jet.accel[k], B))
     return step
 
 
