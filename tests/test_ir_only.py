@@ -117,21 +117,51 @@ def test_on_leaving_the_selected_overloads_are_dropped_and_calls_compile_as_usua
     assert _machine_code(half) is not None
 
 
-def test_inside_only_the_functions_left_out_are_cached(tmp_path, monkeypatch):
-    cache_dir = tmp_path / "numba-cache"  # numba's cache for this test alone
+def _powers_module(tmp_path, monkeypatch):
+    """CACHED_SOURCE imported afresh (new dispatchers) from tmp_path, with numba's cache
+    in tmp_path for this test alone; returns the module and the cache's folder."""
+    cache_dir = tmp_path / "numba-cache"
     monkeypatch.setattr(numba.core.config, "CACHE_DIR", str(cache_dir))
-    (tmp_path / "powers.py").write_text(CACHED_SOURCE)
+    if not (tmp_path / "powers.py").exists():
+        (tmp_path / "powers.py").write_text(CACHED_SOURCE)
     spec = importlib.util.spec_from_file_location("powers", tmp_path / "powers.py")
     module = importlib.util.module_from_spec(spec)
     monkeypatch.setitem(sys.modules, "powers", module)
     spec.loader.exec_module(module)
-    with ir_only.ir_only(lambda _, qualname: qualname == "cube"):
+    return module, cache_dir
+
+
+def _cubes(module, qualname):
+    return qualname == "cube"
+
+
+def test_inside_only_the_functions_left_out_are_cached(tmp_path, monkeypatch):
+    module, cache_dir = _powers_module(tmp_path, monkeypatch)
+    with ir_only.ir_only(_cubes):
         module.cube.compile((float64,))
         module.square.compile((float64,))
     assert not list(cache_dir.rglob("powers.cube-*.nbc"))
     assert list(cache_dir.rglob("powers.square-*.nbc"))
     assert module.cube(2.0) == 8.0
     assert list(cache_dir.rglob("powers.cube-*.nbc"))
+
+
+def test_with_load_cached_the_functions_left_out_are_read_from_the_cache_never_the_selected(
+    tmp_path, monkeypatch
+):
+    module, _ = _powers_module(tmp_path, monkeypatch)
+    assert module.cube(2.0) == 8.0 and module.square(2.0) == 4.0  # both cached
+    module, _ = _powers_module(tmp_path, monkeypatch)
+    with ir_only.ir_only(_cubes):  # the ahead-of-time build's way: nothing read
+        module.square.compile((float64,))
+    assert not module.square._cache_hits
+    module, _ = _powers_module(tmp_path, monkeypatch)
+    with ir_only.ir_only(_cubes, load_cached=True):
+        module.square.compile((float64,))
+        module.cube.compile((float64,))
+        assert _machine_code(module.cube) is None  # compiled to IR, not read
+    assert sum(module.square._cache_hits.values()) == 1
+    assert not module.cube._cache_hits
 
 
 def test_the_replaced_methods_are_numbas_own_again_after_leaving():
@@ -151,6 +181,17 @@ def test_the_replaced_methods_are_numbas_own_again_after_leaving():
     with ir_only.ir_only(_everything):
         assert all(a is not b for a, b in zip(methods(), before, strict=True))
     assert methods() == before
+
+
+def test_the_linear_kernel_selects_its_functions_that_python_does_not_call():
+    from reference.linear import kernel as K
+
+    selected = K.compiled_into_entry_points
+    for helper in ("_law_event", "_step", "_law_impulses", "_held_solve", "_two_sum"):
+        assert selected(K.__name__, helper)
+    for entry in ("start_kernel", "continue_kernel", "first_hit", "_contact_products"):
+        assert not selected(K.__name__, entry)
+    assert not selected("reference.core.impact_laws", "_law_event")
 
 
 def test_the_build_selects_the_loops_layers_and_not_what_tests_load_from_the_cache():

@@ -222,3 +222,12 @@ def test_grid_samples_inside_a_phase_keep_the_linear_energy(name):
             continue
         worst = max(worst, abs(t.energy[i + 1] - t.energy[i]))
     assert worst <= 1e-14 * t.energy[0]
+
+
+def test_a_linear_run_is_timed_without_the_kernels_compilation_and_compiles_it_once():
+    scene = _scene(3, 0.5, 0.5, [0.1, 0.05, 0.2], [0.0, 0.0, 0.0], t_end=1.0)
+    simulate_linear(scene)  # compiled or loaded here, if not before in this process
+    again = simulate_linear(scene)
+    assert again.compile_s == 0.0 and again.wall_time_s > 0.0
+    # the types the kernel was compiled for are those of its calls: nothing more compiled
+    assert len(K.start_kernel.signatures) == 1 and len(K.continue_kernel.signatures) == 1

@@ -40,7 +40,7 @@ def _numba_parts():
         return None
     parts = codegen, cpu, caching, dispatcher, _dynfunc
     try:  # the replacements read the methods they replace
-        replaced = _replacements(parts, lambda module, qualname: False, set(), set())
+        replaced = _replacements(parts, lambda module, qualname: False, set(), set(), False)
     except AttributeError:
         return None
     has_all = all(hasattr(cls, name) for cls, name in replaced)
@@ -60,22 +60,25 @@ _RAISING_ENTRY = ctypes.cast(ctypes.pythonapi.PyObject_Call, ctypes.c_void_p).va
 
 
 @contextmanager
-def ir_only(selected):
+def ir_only(selected, load_cached: bool = False):
     """Inside, for each function that numba compiles and `selected(module, qualname)`
     accepts: its library is finalised without module passes or machine code, its entry
     point raises TypeError when called, and it is not written to numba's on-disk cache.
     The other functions compile as usual, with machine code, and are cached (a selected
-    callee's IR linked into theirs and optimised there).  Nothing is read from numba's
-    cache inside: what is compiled depends on the sources alone.  On leaving, the
-    overloads of the selected functions are dropped, so that a later call compiles them
-    as usual.  Raises RuntimeError where this numba lacks the parts replaced
-    (`available()`)."""
+    callee's IR linked into theirs and optimised there).  A selected function is never
+    read from numba's cache inside; the others are where `load_cached` (the linear
+    kernel's entry points, `reference.linear.kernel.compiling_entry_points`), and
+    otherwise not, so that what is compiled depends on the sources alone (the
+    ahead-of-time build).  On leaving, the overloads of the selected functions are
+    dropped, so that a later call compiles them as usual.  Raises RuntimeError where
+    this numba lacks the parts replaced (`available()`)."""
     parts = _numba_parts()
     if parts is None:
         raise RuntimeError("this numba lacks the internals that ir_only replaces")
     ir_libraries = set()  # the libraries of the selected functions
     placeholders = set()  # the dispatchers holding a placeholder entry point
-    with _replaced(_replacements(parts, selected, ir_libraries, placeholders)):
+    methods = _replacements(parts, selected, ir_libraries, placeholders, load_cached)
+    with _replaced(methods):
         try:
             yield
         finally:
@@ -83,12 +86,13 @@ def ir_only(selected):
                 function._reset_overloads()
 
 
-def _replacements(parts, selected, ir_libraries, placeholders) -> dict:
+def _replacements(parts, selected, ir_libraries, placeholders, load_cached) -> dict:
     """numba's methods that `ir_only` replaces, by (class, name), and their
     replacements; `ir_libraries` and `placeholders` are filled as functions compile."""
     codegen, cpu, caching, dispatcher, dynfunc = parts
     add_module = codegen.JITCPUCodegen._add_module
     get_executable = cpu.CPUContext.get_executable
+    load_overload = caching.Cache.load_overload
     save_overload = caching.Cache.save_overload
     add_overload = dispatcher.Dispatcher.add_overload
     optimize_final_module = codegen.CPUCodeLibrary._optimize_final_module
@@ -116,6 +120,14 @@ def _replacements(parts, selected, ir_libraries, placeholders) -> dict:
             fndesc.lookup_module(), name, doc, _RAISING_ENTRY, env, (library,)
         )
 
+    def load_unless_selected(self, sig, target_context):
+        function = getattr(self, "_py_func", None)  # numba's Cache keeps its function
+        if function is None or not load_cached:
+            return None
+        if selected(function.__module__, function.__qualname__):
+            return None
+        return load_overload(self, sig, target_context)
+
     def save_with_machine_code(self, sig, data):
         if data.library not in ir_libraries:
             save_overload(self, sig, data)
@@ -128,7 +140,7 @@ def _replacements(parts, selected, ir_libraries, placeholders) -> dict:
     return {
         (codegen.JITCPUCodegen, "_add_module"): add_module_for_machine_code,
         (cpu.CPUContext, "get_executable"): placeholder_executable,
-        (caching.Cache, "load_overload"): lambda self, sig, target_context: None,
+        (caching.Cache, "load_overload"): load_unless_selected,
         (caching.Cache, "save_overload"): save_with_machine_code,
         (dispatcher.Dispatcher, "add_overload"): recording_add_overload,
         (codegen.CPUCodeLibrary, "_optimize_final_module"): optimize_unless_ir_only,

@@ -68,11 +68,15 @@ small tuples and arrays, unpacked at their top:
 from __future__ import annotations
 
 import math
+import threading
+import time
+from contextlib import nullcontext
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof
 
 from ..compiled import clear_stale_jit_cache
+from ..core import ir_only
 from ..core.clock import time_until
 from ..core.impact import bounce_ratio, chatter_impulse, impact_impulse, post_impact_velocity
 from ..core.impact_laws import MAX_SEQUENTIAL_IMPACTS, SETTLED
@@ -92,11 +96,53 @@ clear_stale_jit_cache()
 # helpers, e.g. numba.misc.mergesort).  Measured: as ordinary njit functions the split
 # event loop ran 2.5-3 times slower than the single function it replaced.
 _helper = njit(cache=True, forceinline=True, _nrt=False)
-# The law event's helpers: inlined by numba into `_law_event` in its own IR
-# (inline="always"), so that the law's code -- the exact core's law functions, linked
-# into every function that calls them, each optimising it again -- sits in one function
-# called from the top of the loop (`continue_kernel`), not under a chain of helpers.
-_law_helper = njit(cache=True, inline="always", _nrt=False)
+
+# The functions Python calls (`_python_entry`): compiled with machine code and cached.
+# Every other function of this module is compiled only into them, to LLVM IR
+# (`load_entry_points`).
+PYTHON_ENTRY_POINTS: set[str] = set()
+
+
+def _python_entry(function):
+    """numba's `njit(cache=True)` for a function that Python calls, listed in
+    PYTHON_ENTRY_POINTS."""
+    PYTHON_ENTRY_POINTS.add(function.__name__)
+    return njit(cache=True)(function)
+
+
+def compiled_into_entry_points(module: str, qualname: str) -> bool:
+    """Whether a function numba compiles is one of this module's that only its entry
+    points call (`reference.core.ir_only`'s selection)."""
+    return module == __name__ and qualname not in PYTHON_ENTRY_POINTS
+
+
+_LOADING = threading.Lock()
+
+
+def load_entry_points(start_args: tuple, continue_args: tuple) -> float:
+    """`start_kernel` and `continue_kernel` compiled for the types of these arguments, or
+    loaded from numba's cache, before a run is timed; returns the seconds taken (0 where
+    both are in this process already).  They compile with the functions only they call
+    compiled to LLVM IR only (`reference.core.ir_only`): those are linked into the entry
+    points' libraries and optimised there once, never turned into machine code or cached
+    on their own (numba would optimise each one's library whole, its callees linked in,
+    and again in every caller above it).  Where this numba lacks the parts `ir_only`
+    replaces, they compile as numba does by default."""
+    calls = ((start_kernel, start_args), (continue_kernel, continue_args))
+    if all(getattr(entry, "signatures", True) for entry, _ in calls):
+        return 0.0  # compiled (or not numba's: a test's stand-in)
+    t0 = time.perf_counter()
+    with _LOADING, _selecting_helpers():
+        for entry, args in calls:
+            entry.compile(tuple(typeof(arg) for arg in args))
+    return time.perf_counter() - t0
+
+
+def _selecting_helpers():
+    if not ir_only.available():
+        return nullcontext()
+    return ir_only.ir_only(compiled_into_entry_points, load_cached=True)
+
 
 # event kinds
 INITIAL, IMPACT, ACCUMULATION, END = 0, 1, 2, 3
@@ -145,7 +191,7 @@ SF_GRAVITY, SF_T_HI, SF_T_LO, SF_DT_PENDING, SF_LAW_T, SF_LAW_E, SF_SERIES_T = r
 N_SF = 7
 
 
-@njit(cache=True)
+@_python_entry
 def first_hit(g, v, a):
     """First s > 0 with g + v s + a s²/2 = 0 reached while approaching (inf if none).
     g ≥ 0 is the gap now (g ≤ 0 is treated as touching), v its rate, a its acceleration.
@@ -332,7 +378,7 @@ def _scale_q(F, q):
 # ------------------------------------------------------------------ model and scales
 
 
-@njit(cache=True)
+@_python_entry
 def _contact_products(F, tinv):
     """W = F Θ⁻¹ Fᵀ, w_ab = f_aᵀΘ⁻¹f_b: the change of contact a's normal velocity per unit
     impulse at contact b (the paper, section 2.5, eq. impactequ), and max_a w_aa."""
@@ -1109,7 +1155,7 @@ def law_contacts(F, q, p, qs, ps, vfl, together, with_together, out):
     return n
 
 
-@_law_helper
+@_helper
 def _law_progress(si, sf, e_true):
     """Whether the law may act at this stop: the time moved since the last law event,
     or the true energy fell below half its value there (a cascade of simultaneous
@@ -1124,7 +1170,7 @@ def _law_progress(si, sf, e_true):
     return si[SI_LAW_REPEATS] < LAW_MAX_REPEATS
 
 
-@_law_helper
+@_helper
 def _law_failed(si, info, together, contacts, k, outcome, hits):
     """End the run undecided by the law (SIMULTANEOUS, REASON_LAW_UNDECIDED): its outcome
     and single impacts into info, the contacts of the impact flagged in `together`."""
@@ -1137,7 +1183,7 @@ def _law_failed(si, info, together, contacts, k, outcome, hits):
     _stop(si, info, SIMULTANEOUS, REASON_LAW_UNDECIDED, -1, -1)
 
 
-@_law_helper
+@_helper
 def _any_approaching(F, p, ps, vfl, contacts, k):
     """Whether a contact of contacts[:k] approaches beyond roundoff."""
     for i in range(k):
@@ -1146,7 +1192,7 @@ def _any_approaching(F, p, ps, vfl, contacts, k):
     return False
 
 
-@_law_helper
+@_helper
 def _law_impulses(model, law, p, contacts, k, gamma, lawws):
     """(status, single impacts) of the run's law on contacts[:k] (the exact core's law
     functions through its dispatch, law_dispatch.solve_law): Delassus matrix
@@ -1174,7 +1220,7 @@ def _law_impulses(model, law, p, contacts, k, gamma, lawws):
     return solve_law(law, W, u_pre, gamma, k, lam, u_post, work)
 
 
-@_law_helper
+@_helper
 def _add_law_impulses(F, tinv, contacts, k, lam, p):
     """p ← p + Θ⁻¹F_SᵀΛ, contact by contact (as `_apply_impulse`)."""
     for i in range(k):
@@ -1182,7 +1228,7 @@ def _add_law_impulses(F, tinv, contacts, k, lam, p):
             _add_impulse(F, tinv, contacts[i], lam[i], p)
 
 
-@_law_helper
+@_helper
 def _law_completes(u_post, k, gamma, below):
     """Whether, with 0 < γ < 1, some contact leaves the impact (u⁺ above LEAVING_ULPS
     ulps of `below`) and every one that does leaves at u⁺ ≤ `below`: the bounces that
@@ -1199,7 +1245,7 @@ def _law_completes(u_post, k, gamma, below):
     return leaving
 
 
-@_law_helper
+@_helper
 def _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q, p_pre, p):
     """One IMPACT row per contact that took an impulse, at the impact's time (the first
     carries the interval before it, the others 0)."""
@@ -1218,7 +1264,7 @@ def _law_rows(out, si, sf, held, acc, contacts, k, lawws, E, E_post, q, p_pre, p
     sf[SF_DT_PENDING] = 0.0
 
 
-@_law_helper
+@_helper
 def _rest_acceleration(F, tinv, g, rest, m, acc):
     """The constant acceleration with the m ≤ 2 contacts rest[:m] held (F_B Θ⁻¹ F_Bᵀ η
     = g 1, ṗ = Θ⁻¹F_Bᵀη − g u3: the paper, section 2.5, eq. pacccontact) into acc;
@@ -1239,13 +1285,13 @@ def _rest_acceleration(F, tinv, g, rest, m, acc):
     return True
 
 
-@_law_helper
+@_helper
 def _theta_dot(thd, x, y):
     """xᵀΘy."""
     return x[0] * (thd[0] * y[0]) + x[1] * (thd[1] * y[1]) + x[2] * (thd[2] * y[2])
 
 
-@_law_helper
+@_helper
 def _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, a):
     """κ of the self-similar bounce series a law impact at q = 0 (every contact touching)
     that left p⁺ = p may start (`_bounce_series`), with the contacts left resting (|u⁺|
@@ -1276,7 +1322,7 @@ def _series_rate(model, p, contacts, k, u_post, vfl, gt, rest, a):
     return kappa, m
 
 
-@_law_helper
+@_helper
 def _series_maps_back(model, law, p, contacts, k, lawws, pn, miss):
     """Whether the law maps −p⁺ (p⁺ = p) to γp⁺ (to SELF_SIMILAR_TOL, in the Θ norm):
     every bounce of the series is then the first × γ^(j−1).  Leaves the law's impulses,
@@ -1294,7 +1340,7 @@ def _series_maps_back(model, law, p, contacts, k, lawws, pn, miss):
     return _theta_dot(thd, miss, miss) <= SELF_SIMILAR_TOL**2 * _theta_dot(thd, p, p)
 
 
-@_law_helper
+@_helper
 def _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts, k, flight, m):
     """The bounces of a self-similar series after the law impact at the current time, p⁺
     = p (`_bounce_series`): bounce j at t + flight (1 − γʲ)/(1 − γ), one IMPACT row per
@@ -1348,7 +1394,7 @@ def _series_rows(model, limits, state, scratch, out, si, sf, lawws, contacts, k,
     return last_hi, last_lo
 
 
-@_law_helper
+@_helper
 def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, vfl):
     """After a law impact at q = 0 with every contact touching (p⁺ = p): the Zeno series
     of self-similar bounces, completed in closed form when there is one (docs/laws.md,
@@ -1392,7 +1438,7 @@ def _bounce_series(model, limits, state, scratch, out, si, sf, info, lawws, cont
     return True
 
 
-@_law_helper
+@_helper
 def _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contacts, k, E, vfl):
     """The impact of contacts[:k] under the run's law (`_law_event`): Λ, p⁺ = p⁻ +
     Θ⁻¹F_SᵀΛ, one IMPACT row per contact that took an impulse; bounces too small to
@@ -1427,7 +1473,7 @@ def _law_impact(model, limits, state, scratch, out, si, sf, info, lawws, contact
                               contacts, k, vfl)  # fmt: skip
 
 
-@_law_helper
+@_helper
 def _go_on(model, state, out, si, sf, info):
     """Go on after a law event as from a start (`_start`) at the state (q, p): the
     scales renormalised, the contacts resting there closed, the held set (none until
@@ -1587,7 +1633,7 @@ def new_law_scratch(n_contacts: int, vec_floats: int):
     )
 
 
-@njit(cache=True)
+@_python_entry
 def start_kernel(
     F, thd, tinv, w, wmax, mass, g, gamma, rank_f, q_init, p_init, record_states,
     out_i, out_f, out_s, info, q, p, qs, ps, acc, held, closed, si, sf,
@@ -1624,7 +1670,7 @@ def start_kernel(
     return False
 
 
-@njit(cache=True)
+@_python_entry
 def continue_kernel(
     F, thd, tinv, w, wmax, mass, gamma, rank_f, t_end, max_impacts, log2_energy_floor,
     chatter_tol, decouple_tol, window, law, record_states, out_i, out_f, out_s, info,
@@ -1661,7 +1707,7 @@ def continue_kernel(
     return si[SI_EVENTS]
 
 
-@njit(cache=True)
+@_python_entry
 def log2_time_to_go(log2_dt, log2_rest):
     """log2(t_f − t_i) for every event i: log2 of the rest after the last event combined
     with the intervals that follow each event, summed from the end in log space
@@ -1679,7 +1725,7 @@ def log2_time_to_go(log2_dt, log2_rest):
     return out
 
 
-@njit(cache=True)
+@_python_entry
 def log2_segment_sums(log2_dt, idx):
     """log2 of the time from event idx[k] to event idx[k+1] (the intervals
     log2_dt[idx[k]+1 .. idx[k+1]] summed), for consecutive entries of idx."""

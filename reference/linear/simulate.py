@@ -215,6 +215,7 @@ def trajectory_from_run(
     ]
     stats = {
         "wall_time_s": run.wall_time_s,
+        "compile_s": run.compile_s,
         "n_events": int(len(run.kind)),
         "accumulations": accumulations,
         "simultaneous_impacts": run.simultaneous_impacts,
