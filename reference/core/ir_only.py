@@ -1,5 +1,7 @@
 """numba compiling chosen functions to LLVM IR only, for the ahead-of-time build
-(`reference.core.aot`, which chooses the event loop's own layers: `aot.LOOP_LAYERS`).
+(`reference.core.aot`, which chooses the event loop's own layers: `aot.LOOP_LAYERS`)
+and for the linear model's kernel (`reference.linear.kernel.load_entry_points`, which
+chooses every function of the kernel that Python does not call).
 
 numba.pycc compiles each function that an exported function calls as numba's own
 just-in-time function: lowered to LLVM IR, its library optimised whole (LLVM's module
@@ -67,7 +69,7 @@ def ir_only(selected, load_cached: bool = False):
     The other functions compile as usual, with machine code, and are cached (a selected
     callee's IR linked into theirs and optimised there).  A selected function is never
     read from numba's cache inside; the others are where `load_cached` (the linear
-    kernel's entry points, `reference.linear.kernel.compiling_entry_points`), and
+    kernel's entry points, `reference.linear.kernel.load_entry_points`), and
     otherwise not, so that what is compiled depends on the sources alone (the
     ahead-of-time build).  On leaving, the overloads of the selected functions are
     dropped, so that a later call compiles them as usual.  Raises RuntimeError where
