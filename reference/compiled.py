@@ -81,6 +81,29 @@ def fresh_aot_module():
         return None
 
 
+def numba_cache_folder(source_folder: Path) -> Path:
+    """The folder where numba caches the compiled functions of `source_folder`'s modules,
+    as numba's own cache locators choose it: under NUMBA_CACHE_DIR when that is set, else
+    the folder's __pycache__ where it can be written, else numba's user-wide cache.  The
+    folder's __pycache__ where this numba's locators are not the ones read here."""
+    sources = sorted(source_folder.glob("*.py"))  # numba locates a cache for a source file
+    try:
+        from numba.core import caching
+
+        impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl", None)
+        for locator_class in getattr(impl, "_locator_classes", ()) if sources else ():
+            locator = locator_class.from_function(_locator_probe, str(sources[0]))
+            if locator is not None:
+                return Path(locator.get_cache_path())
+    except (ImportError, AttributeError, TypeError):
+        pass
+    return source_folder / "__pycache__"
+
+
+def _locator_probe():
+    """A function for numba's cache locators to read a first line from."""
+
+
 def clear_stale_jit_cache() -> None:
     """numba's cache does not notice that a function called from another module has
     changed; after any change to the core's or the linear model's sources the cached
@@ -90,14 +113,15 @@ def clear_stale_jit_cache() -> None:
     if _cache_checked:
         return
     _cache_checked = True
-    stamp_file = CORE_DIR / "__pycache__" / "jit.stamp"
+    caches = [numba_cache_folder(folder) for folder in JIT_CACHED]
+    stamp_file = caches[0] / "jit.stamp"
     stamp = _sources_stamp(JIT_CACHED)  # the linear kernel calls the core's functions
     try:
         if stamp_file.read_text().strip() == stamp:
             return
     except OSError:
         pass
-    for cache in (folder / "__pycache__" for folder in JIT_CACHED):
+    for cache in caches:
         for path in list(cache.glob("*.nbi")) + list(cache.glob("*.nbc")):
             path.unlink(missing_ok=True)
     try:

@@ -22,12 +22,14 @@ def sources(tmp_path, monkeypatch):
 
 
 def cache_files(folder):
-    return sorted(p.name for p in (folder / "__pycache__").glob("*.nb[ic]"))
+    return sorted(p.name for p in compiled.numba_cache_folder(folder).glob("*.nb[ic]"))
 
 
 def fill(folder):
+    cache = compiled.numba_cache_folder(folder)
+    cache.mkdir(parents=True, exist_ok=True)
     for name in ("m.f-1.py311.nbi", "m.f-1.py311.1.nbc"):
-        (folder / "__pycache__" / name).write_bytes(b"machine code")
+        (cache / name).write_bytes(b"machine code")
 
 
 def check(monkeypatch):
@@ -59,3 +61,20 @@ def test_a_changed_linear_source_drops_both_caches(sources, monkeypatch):
     (linear / "m.py").write_text("x = 2\n")
     check(monkeypatch)
     assert cache_files(core) == [] and cache_files(linear) == []
+
+
+def test_under_numba_cache_dir_a_changed_source_drops_the_cache_numba_reads(
+    sources, tmp_path, monkeypatch
+):
+    import numba.core.config
+
+    core, linear = sources
+    monkeypatch.setattr(numba.core.config, "CACHE_DIR", str(tmp_path / "numba-cache"))
+    cache = compiled.numba_cache_folder(core)
+    assert cache.is_relative_to(tmp_path / "numba-cache")  # numba's own choice of folder
+    check(monkeypatch)
+    fill(core), fill(linear)
+    (core / "m.py").write_text("x = 2\n")
+    check(monkeypatch)
+    assert cache_files(core) == [] and cache_files(linear) == []
+    assert (cache / "jit.stamp").exists() and not (core / "__pycache__" / "jit.stamp").exists()
