@@ -139,6 +139,8 @@ def load_entry_points(start_args: tuple, continue_args: tuple) -> float:
 
 
 def _selecting_helpers():
+    """`ir_only` of the functions compiled into the entry points, the others read from
+    numba's cache; nothing where this numba lacks the parts `ir_only` replaces."""
     if not ir_only.available():
         return nullcontext()
     return ir_only.ir_only(compiled_into_entry_points, load_cached=True)
