@@ -5,10 +5,11 @@ elsewhere) and in a real browser (headless Chromium, when installed)."""
 from __future__ import annotations
 
 import base64
+import contextlib
+import io
 import json
 import shutil
 import subprocess
-import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -44,11 +45,13 @@ class Tags(HTMLParser):
         return [a for t, a in self.tags if t == name]
 
 
-def _harness(argv: list[str], stdout=subprocess.PIPE) -> subprocess.CompletedProcess:
-    """The command as a user runs it (a separate process)."""
-    return subprocess.run(
-        [sys.executable, "-m", "harness", *argv], stdout=stdout, stderr=subprocess.PIPE, text=True
-    )
+def _harness_json(argv: list[str], out: Path) -> None:
+    """`harness ARGV --json > OUT`, run in this process (the commands' own `main`: the
+    same document a separate process writes, without a new interpreter's imports)."""
+    err = io.StringIO()
+    with open(out, "w") as fh, contextlib.redirect_stdout(fh), contextlib.redirect_stderr(err):
+        rc = main([*argv, "--json"])
+    assert rc == 0, err.getvalue()
 
 
 @pytest.fixture(scope="module")
@@ -65,17 +68,12 @@ def results(tmp_path_factory):
     runs["bench"] += ["--repeats", "1"]
     runs["fidelity"] += ["--eps-grid", "1:1e-2:3"]
     for kind, argv in runs.items():
-        out = root / f"{kind}.json"
-        with open(out, "w") as fh:
-            done = _harness([*argv, "--json"], stdout=fh)
-        assert done.returncode == 0, done.stderr
-        docs[kind] = out
+        docs[kind] = root / f"{kind}.json"
+        _harness_json(argv, docs[kind])
     sweep_root = root / "sweep"
     argv = ["sweep", "exponent", "--gyration", "0.3:0.5:2", "--restitution", "0.3:0.6:2"]
     argv += ["--samples", "2", "--engine", "linear", "--workers", "1", "--out", str(sweep_root)]
-    with open(root / "sweep.json", "w") as fh:
-        done = _harness([*argv, "--json"], stdout=fh)
-    assert done.returncode == 0, done.stderr
+    _harness_json(argv, root / "sweep.json")
     docs["sweep"] = root / "sweep.json"
     docs["sweep_dir"] = sweep_root / "linear"
     return docs
@@ -86,8 +84,7 @@ def report(results, tmp_path_factory):
     """A report of every kind of result."""
     out = tmp_path_factory.mktemp("report") / "report.html"
     inputs = [str(results[k]) for k in ("compare", "bench", "fidelity", "stress", "sweep")]
-    done = _harness(["report", *inputs, "--out", str(out)])
-    assert done.returncode == 0, done.stderr
+    assert main(["report", *inputs, "--out", str(out)]) == 0
     return out
 
 

@@ -16,6 +16,11 @@ Contacts (docs/architecture.md, "The model"):
 
 For all, d(gap)/dt = n·(v + ω × r) and the normal acceleration is J_k [v̇; ω̇] + bias_k
 with J_k = [nᵀ, (r_k × n)ᵀ].
+
+Elementwise formulas on 3-vectors are written on Python floats (numpy's per-call cost
+on such tiny arrays is far above the arithmetic; the same operations in the same order
+give the same doubles); dot and matrix products stay numpy's, whose summation order
+(BLAS) the results depend on.
 """
 
 from __future__ import annotations
@@ -36,15 +41,24 @@ EPS = np.finfo(float).eps
 X, Q, V, W = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
 
 
+def _cross3(a, b) -> tuple[float, float, float]:
+    """a × b of two 3-vectors given as sequences of floats."""
+    a0, a1, a2 = a
+    b0, b1, b2 = b
+    return (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+
+
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b for 3-vectors or stacks of them (rows); much cheaper than np.cross (two
-    3-vectors, the common case, without np.stack's overhead)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    c = (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+    """a × b for 3-vectors or stacks of them (rows, (k, 3)); a single vector is crossed
+    with every row of the other.  Much cheaper than np.cross on such small arrays: the
+    components are crossed as Python floats."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     if a.ndim == 1 and b.ndim == 1:
-        return np.array(c)
-    return np.stack(c, axis=-1)
+        return np.array(_cross3(a.tolist(), b.tolist()))
+    rows_a = a.tolist() if a.ndim == 2 else [a.tolist()] * len(b)
+    rows_b = b.tolist() if b.ndim == 2 else [b.tolist()] * len(a)
+    rows = [_cross3(r, s) for r, s in zip(rows_a, rows_b, strict=True)]
+    return np.array(rows).reshape(-1, 3)
 
 
 def bumpy_points(scene: Scene) -> np.ndarray:
@@ -61,8 +75,22 @@ def bumpy_points(scene: Scene) -> np.ndarray:
 def _rim_heights(q: np.ndarray, pts: np.ndarray) -> np.ndarray:
     """(R p)_z of body-frame points p in the plane of the polygon (p_z = 0), formed from
     the quaternion's small terms directly: R's z-row is (2(xz − wy), 2(yz + wx), ·)."""
-    wq, xq, yq, zq = q
+    wq, xq, yq, zq = qt.components(q)
     return pts[:, 0] * (2 * (xq * zq - wq * yq)) + pts[:, 1] * (2 * (yq * zq + wq * xq))
+
+
+def _identity_plus_axis(a: float, c: float, e3: np.ndarray) -> np.ndarray:
+    """a 1 + c e3 e3ᵀ written out entry by entry, (a δ_ij) + c (e_i e_j), the operations
+    of a * np.eye(3) + c * np.outer(e3, e3) (0.0 + … off the diagonal: −0.0 becomes 0.0
+    there as in that sum)."""
+    e0, e1, e2 = e3.tolist()
+    return np.array(
+        [
+            [a + c * (e0 * e0), 0.0 + c * (e0 * e1), 0.0 + c * (e0 * e2)],
+            [0.0 + c * (e1 * e0), a + c * (e1 * e1), 0.0 + c * (e1 * e2)],
+            [0.0 + c * (e2 * e0), 0.0 + c * (e2 * e1), a + c * (e2 * e2)],
+        ]
+    )
 
 
 @dataclass(frozen=True)
@@ -119,12 +147,12 @@ class BodyModel:
     # ------------------------------------------------------------------ inertia
     def inertia_world(self, q: np.ndarray) -> np.ndarray:
         """I_w = i1 1 + (i3 − i1) e3 e3ᵀ (axisymmetric body)."""
-        e3 = qt.body_axis(q)
-        return self.i1 * np.eye(3) + (self.i3 - self.i1) * np.outer(e3, e3)
+        return _identity_plus_axis(self.i1, self.i3 - self.i1, qt.body_axis(q))
 
     def inv_inertia_world(self, q: np.ndarray) -> np.ndarray:
+        """I_w⁻¹ = 1/i1 + (1/i3 − 1/i1) e3 e3ᵀ."""
         e3 = qt.body_axis(q)
-        return np.eye(3) / self.i1 + (1.0 / self.i3 - 1.0 / self.i1) * np.outer(e3, e3)
+        return _identity_plus_axis(1.0 / self.i1, 1.0 / self.i3 - 1.0 / self.i1, e3)
 
     # ------------------------------------------------------------------ contacts
     def contacts(self, y: np.ndarray, idx=None):
@@ -134,6 +162,10 @@ class BodyModel:
         Returns (gap (k,), normal (k,3), lever (k,3), vn (k,), noise (k,)) where `noise`
         is the roundoff level of the gap (a few ulps of the terms that form it)."""
         idx = np.arange(self.n_contacts) if idx is None else np.asarray(idx, dtype=int)
+        if not len(self.bumps):  # only rim vertices
+            return self._rim_contacts(y, self.vertices[idx])
+        if not self.n_rim:  # only bumps
+            return self._bump_contacts(y, self.bumps[idx])
         rim = idx < self.n_rim
         if rim.all():
             return self._rim_contacts(y, self.vertices[idx])
@@ -157,15 +189,16 @@ class BodyModel:
 
     def _rim_contacts(self, y: np.ndarray, pts: np.ndarray):
         """Vertices (body frame) on the plane z = 0: gap z + (R p)_z, normal e_z."""
-        x, q, v, w = y[X], y[Q], y[V], y[W]
+        q = y[Q]
+        z, vz, w0, w1 = float(y[2]), float(y[9]), float(y[10]), float(y[11])
         lever = pts @ qt.to_matrix(q).T
         rz = _rim_heights(q, pts)
         lever[:, 2] = rz
-        gap = x[2] + rz
-        normal = np.zeros_like(lever)
+        gap = z + rz
+        normal = np.zeros(lever.shape)
         normal[:, 2] = 1.0
-        vn = v[2] + (w[0] * lever[:, 1] - w[1] * lever[:, 0])
-        noise = 8 * EPS * (abs(x[2]) + np.abs(rz))
+        vn = vz + (w0 * lever[:, 1] - w1 * lever[:, 0])
+        noise = 8 * EPS * (abs(z) + np.abs(rz))
         return gap, normal, lever, vn, noise
 
     def _bump_contacts(self, y: np.ndarray, pts: np.ndarray):
@@ -175,8 +208,9 @@ class BodyModel:
         d = x[None, :] - pts  # x − b_k
         gap = d @ e3
         lever = -d + gap[:, None] * e3[None, :]  # in-plane part of b_k − x
-        normal = np.array(np.broadcast_to(e3, lever.shape))
-        vn = v @ e3 + cross(w[None, :], lever) @ e3
+        normal = np.empty_like(lever)
+        normal[:] = e3
+        vn = v @ e3 + cross(w, lever) @ e3
         noise = 8 * EPS * (np.abs(d) @ np.abs(e3))
         return gap, normal, lever, vn, noise
 
@@ -196,23 +230,34 @@ class BodyModel:
 
         rim vertex: (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z.
         bump: 2 v·(ω × e3) + (x − b)·(ω × (ω × e3))."""
-        v, w = y[V], y[W]
+        w = y[W]
         idx = np.arange(self.n_contacts) if idx is None else np.asarray(idx, dtype=int)
+        if not len(self.bumps):  # only rim vertices
+            return (lever @ w) * float(w[2]) - float(w @ w) * lever[:, 2]
+        if not self.n_rim:  # only bumps
+            return self._bump_bias(y, self.bumps[idx])
         rim = idx < self.n_rim
         out = np.empty(len(idx))
         if rim.any():
             r = lever[rim]
             out[rim] = (r @ w) * w[2] - float(w @ w) * r[:, 2]
         if not rim.all():
-            e3 = qt.body_axis(y[Q])
-            we3 = cross(w, e3)
-            d = y[X][None, :] - self.bumps[idx[~rim] - self.n_rim]
-            out[~rim] = 2.0 * (v @ we3) + d @ cross(w, we3)
+            out[~rim] = self._bump_bias(y, self.bumps[idx[~rim] - self.n_rim])
         return out
 
+    def _bump_bias(self, y: np.ndarray, pts: np.ndarray) -> np.ndarray:
+        """bias of the bumps at pts: 2 v·(ω × e3) + (x − b)·(ω × (ω × e3))."""
+        v, w = y[V], y[W]
+        e3 = qt.body_axis(y[Q])
+        we3 = cross(w, e3)
+        d = y[X][None, :] - pts
+        return 2.0 * (v @ we3) + d @ cross(w, we3)
+
     def mass_matrix_inv(self, q: np.ndarray) -> np.ndarray:
+        """M⁻¹ = diag(1/m, 1/m, 1/m, I_w⁻¹)."""
         Minv = np.zeros((6, 6))
-        Minv[:3, :3] = np.eye(3) / self.mass
+        for i in range(3):
+            Minv[i, i] = 1.0 / self.mass
         Minv[3:, 3:] = self.inv_inertia_world(q)
         return Minv
 
@@ -221,7 +266,7 @@ class BodyModel:
         q, w = y[Q], y[W]
         Iw = self.inertia_world(q)
         wdot = -self.inv_inertia_world(q) @ cross(w, Iw @ w)
-        return np.array([0.0, 0.0, -self.gravity, *wdot])
+        return np.array([0.0, 0.0, -self.gravity, *wdot.tolist()])
 
     # ------------------------------------------------------------------ energy
     def kinetic_energy(self, y: np.ndarray) -> float:

@@ -123,7 +123,7 @@ def constrained_rhs(model: BodyModel, contacts: list[int]):
         dy = np.empty(13)
         dy[X] = y[V]
         w = y[W]
-        dy[Q] = 0.5 * qt.multiply(np.array([0.0, *w]), y[Q])
+        dy[Q] = 0.5 * qt.multiply([0.0, *w.tolist()], y[Q])
         dy[V] = acc[:3]
         dy[W] = acc[3:]
         return dy

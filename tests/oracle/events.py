@@ -237,12 +237,14 @@ def _safe_step(jet: GapJet, K: float, B: float) -> float:
     smallest step found, no later contact can lower it."""
     # touching and not approaching: bound from the positive-rate side
     gaps = np.where(jet.gap <= jet.noise, np.maximum(jet.gap, 0.0) + jet.noise, jet.gap)
-    lower = [quadratic_root_lower_bound(g, r, K) for g, r in zip(gaps, jet.rate, strict=True)]
+    # the scalar root finding on Python floats (numpy's scalars are slow; same doubles)
+    gaps, rate, accel = gaps.tolist(), jet.rate.tolist(), jet.accel.tolist()
+    lower = [quadratic_root_lower_bound(g, r, K) for g, r in zip(gaps, rate, strict=True)]
     step = math.inf
     for k in sorted(range(len(lower)), key=lower.__getitem__):
         if lower[k] >= step:
             break
-        step = min(step, _raised_by_cubic(lower[k], gaps[k], jet.rate[k], jet.accel[k], B))
+        step = min(step, _raised_by_cubic(lower[k], gaps[k], rate[k], accel[k], B))
     return step
 
 

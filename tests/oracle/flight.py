@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import quaternion as qt
-from .body import BodyModel, Q, V, W, X, cross
+from .body import BodyModel, Q, W, cross
 
 
 @dataclass(frozen=True)
@@ -61,21 +61,32 @@ def flight_constants(model: BodyModel, y0: np.ndarray) -> FlightConstants:
 
 
 def free_flight(fc: FlightConstants, s: float) -> np.ndarray:
-    """State after a free flight of duration s from fc.y0 (closed form)."""
-    y0 = fc.y0
-    y = np.empty(13)
+    """State after a free flight of duration s from fc.y0 (closed form): the parabola
+    x0 + v0 s − ½ g s² e_z, v0 − g s e_z, q = Rot(L/A · s) q0 Rot(ẑ, λ s) and
+    ω = L/A + λ e3 (components as Python floats, see quaternion.py)."""
+    x0, x1, x2, *q0, v0, v1, v2 = fc.y0[:10].tolist()
     g = fc.gravity
-    y[X] = y0[X] + y0[V] * s
-    y[2] -= 0.5 * g * s * s
-    y[V] = y0[V]
-    y[9] -= g * s
-    q_prec = qt.from_rotation_vector(fc.L_over_A * s)
+    L = fc.L_over_A.tolist()
+    q_prec = qt.from_rotation_vector([L[0] * s, L[1] * s, L[2] * s])
     half = 0.5 * fc.lam * s
-    q_spin = np.array([math.cos(half), 0.0, 0.0, math.sin(half)])
-    q = qt.multiply(qt.multiply(q_prec, y0[Q]), q_spin)
-    y[Q] = qt.normalize(q)
-    y[W] = fc.L_over_A + fc.lam * qt.body_axis(y[Q])
-    return y
+    q_spin = [math.cos(half), 0.0, 0.0, math.sin(half)]
+    q = qt.normalize(qt.multiply(qt.multiply(q_prec, q0), q_spin))
+    e0, e1, e2 = qt.body_axis(q).tolist()
+    lam = fc.lam
+    return np.array(
+        [
+            x0 + v0 * s,
+            x1 + v1 * s,
+            x2 + v2 * s - 0.5 * g * s * s,
+            *q.tolist(),
+            v0,
+            v1,
+            v2 - g * s,
+            L[0] + lam * e0,
+            L[1] + lam * e1,
+            L[2] + lam * e2,
+        ]
+    )
 
 
 def flight_acceleration(fc: FlightConstants, y: np.ndarray) -> np.ndarray:
