@@ -95,10 +95,13 @@ def exponent_from_period(log2_tau, log2_energy_pre, P: int, tail: int = 60) -> d
     lt, lE = lt[:m], lE[:m]
     if m < 2 * P + 2:
         return {"c": None, "c_spread": None, "period": P}
-    lD = np.array([_log2_sum(lt[i : i + P]) for i in range(m - P + 1)])
-    i = np.arange(max(0, len(lD) - P - tail), len(lD) - P)
+    # D_i for the windows the last `tail` ratios read: i and i + P, i from `first`
+    n_windows = m - P + 1
+    first = max(0, n_windows - P - tail)
+    lD = np.array([_log2_sum(lt[j : j + P]) for j in range(first, n_windows)])
+    i = np.arange(first, n_windows - P)
     num = lE[i] - lE[i + P]
-    den = lD[i] - lD[i + P]
+    den = lD[i - first] - lD[i - first + P]
     ok = np.isfinite(num) & np.isfinite(den) & (den != 0)
     if not ok.any():
         return {"c": None, "c_spread": None, "period": P}
