@@ -18,9 +18,10 @@ while the other idles.  `ordered` sorts the collected tests so that:
 4. then the rest, as collected.
 
 FILE_SECONDS holds the files that take ≥ 2 s, their CPU seconds (the test process's and
-its children's) on a 2-core machine, numba's and JAX's caches as `make setup` leaves them
-(docs/performance.md, "Where the tests' time goes").  The order only moves time between
-the workers: any order gives the same results."""
+its children's) in one run of `make test`'s command on a clean clone of a 2-core machine,
+numba's and JAX's caches as `make setup` leaves them (docs/performance.md, "Where the
+tests' time goes").  The order only moves time between the workers: any order gives the
+same results."""
 
 from __future__ import annotations
 
@@ -30,33 +31,37 @@ from pathlib import Path
 import pytest
 
 FILE_SECONDS = {
-    "test_oracle.py": 18.7,
-    "test_report.py": 15.2,
-    "test_readme_commands.py": 12.3,
-    "test_engine_mjx.py": 12.0,
-    "test_sweep.py": 9.3,
-    "test_signals.py": 7.6,
-    "test_paper_figures.py": 7.4,
-    "test_reference_search.py": 7.2,
-    "test_reference_rim.py": 7.2,
-    "test_fuzz_cli.py": 4.7,
-    "test_law_registry.py": 4.5,
-    "test_sweep_parts.py": 4.4,
-    "test_extras_ci.py": 4.1,
-    "test_core_flight.py": 3.7,
-    "test_engine_drake.py": 3.5,
-    "test_docs_figures.py": 3.4,
-    "test_core_roots.py": 3.1,
-    "test_compliant_law.py": 3.1,
-    "test_horizon.py": 2.7,
-    "test_linear_impact_laws.py": 2.6,
-    "test_core_contacts.py": 2.6,
-    "test_reference_end.py": 2.6,
-    "test_write_faults.py": 2.3,
-    "test_core_dop853.py": 2.3,
-    "test_cli.py": 2.2,
-    "test_stall_guard.py": 2.2,
-    "test_sweep_heal.py": 2.1,
+    "test_oracle.py": 20.6,
+    "test_readme_commands.py": 15.7,
+    "test_paper_figures.py": 15.7,
+    "test_engine_mjx.py": 14.9,
+    "test_sweep.py": 12.2,
+    "test_reference_rim.py": 11.1,
+    "test_report.py": 10.5,
+    "test_reference_search.py": 9.6,
+    "test_fuzz_cli.py": 8.2,
+    "test_signals.py": 7.7,
+    "test_law_registry.py": 7.1,
+    "test_engine_drake.py": 6.5,
+    "test_core_roots.py": 5.3,
+    "test_core_flight.py": 5.3,
+    "test_sweep_parts.py": 5.2,
+    "test_core_contacts.py": 5.0,
+    "test_docs_figures.py": 4.7,
+    "test_core_dop853.py": 4.7,
+    "test_compliant_law.py": 4.5,
+    "test_linear_impact_laws.py": 3.9,
+    "test_reference_end.py": 3.9,
+    "test_horizon.py": 3.5,
+    "test_fidelity.py": 3.2,
+    "test_write_faults.py": 3.2,
+    "test_extras_ci.py": 2.9,
+    "test_sweep_heal.py": 2.4,
+    "test_cli.py": 2.4,
+    "test_impact_laws.py": 2.4,
+    "test_stall_guard.py": 2.3,
+    "test_oracle_bumpy.py": 2.2,
+    "test_recording.py": 2.1,
 }
 
 # files whose tests start process pools in the test process
