@@ -98,6 +98,18 @@ def test_rod_is_rank_two_and_polygon_points_are_exactly_symmetric():
     assert pts[1, 0] == 0.0 and pts[2, 1] == 0.0
 
 
+def test_models_on_one_polygon_share_its_contact_vectors_and_their_rank():
+    """F (rows (y_k, −x_k, 1), eq. fi) and its rank depend on the points alone: formed
+    once for every (ρ, γ) of a polygon, and another polygon's are its own."""
+    a, b = LinearModel.polygon(6, 0.3, 0.2), LinearModel.polygon(6, 0.7, 0.9)
+    assert a.F is b.F and a.rank == b.rank == 3
+    ang = 2 * np.pi * np.arange(6) / 6
+    assert np.allclose(a.F, np.column_stack([np.sin(ang), -np.cos(ang), np.ones(6)]), atol=1e-15)
+    rod = LinearModel.polygon(2, 0.3, 0.2)
+    assert rod.F is not a.F and rod.rank == 2 and rod.F.shape == (2, 3)
+    assert LinearModel.polygon(6, 0.3, 0.2, radius=2.0).F is not a.F
+
+
 def test_full_state_mapping_matches_the_scene_mapping():
     q, p = np.array([1e-3, -2e-3, 0.05]), np.array([0.3, 0.1, -0.2])
     y = full_states(q, p)[0]

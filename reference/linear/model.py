@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -59,6 +59,15 @@ def contact_vectors(points: np.ndarray) -> np.ndarray:
     """Rows f_k = (y_k, −x_k, 1) (eq. fi)."""
     points = np.asarray(points, dtype=float)
     return np.column_stack([points[:, 1], -points[:, 0], np.ones(len(points))])
+
+
+@lru_cache(maxsize=256)
+def _contact_geometry(points: bytes, n_points: int) -> tuple[np.ndarray, int]:
+    """(F, rank F) of the contact points given as the bytes of their (n, 2) float array:
+    they depend on the points alone, and the analyses form thousands of models on the
+    same polygon (a sweep map's CC and PCC regions: 5,429 (ρ, γ) cells)."""
+    F = contact_vectors(np.frombuffer(points).reshape(n_points, 2))
+    return F, int(np.linalg.matrix_rank(F))
 
 
 def rotation(n: int) -> np.ndarray:
@@ -188,7 +197,13 @@ class LinearModel:
     # kernel, which takes F and Θ), and no caller writes into them.
     @cached_property
     def F(self) -> np.ndarray:
-        return contact_vectors(self.points)
+        return self._geometry[0]
+
+    @cached_property
+    def _geometry(self) -> tuple[np.ndarray, int]:
+        """(F, rank F), shared by the models on the same contact points."""
+        points = np.ascontiguousarray(self.points, dtype=float)
+        return _contact_geometry(points.tobytes(), len(points))
 
     @cached_property
     def theta(self) -> np.ndarray:
@@ -223,7 +238,7 @@ class LinearModel:
     def rank(self) -> int:
         """Rank of the contact vectors: 3 for n >= 3 (three contacts down ⇒ q = 0), 2 for
         the rod (φx, the roll about the rod's own axis, is invisible to its contacts)."""
-        return int(np.linalg.matrix_rank(self.F))
+        return self._geometry[1]
 
 
 def linear_state(scene) -> tuple[np.ndarray, np.ndarray]:
