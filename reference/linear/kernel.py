@@ -99,7 +99,8 @@ _helper = njit(cache=True, forceinline=True, _nrt=False)
 
 # The functions Python calls (`_python_entry`): compiled with machine code and cached.
 # Every other function of this module is compiled only into them, to LLVM IR
-# (`load_entry_points`).
+# (`load_entry_points`); one that Python calls elsewhere (the law event's helpers that
+# `laws.apply_law` calls) is compiled on that first call as numba's own, and cached.
 PYTHON_ENTRY_POINTS: set[str] = set()
 
 
