@@ -79,6 +79,11 @@ def _rim_heights(q: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return pts[:, 0] * (2 * (xq * zq - wq * yq)) + pts[:, 1] * (2 * (yq * zq + wq * xq))
 
 
+def _rim_bias(lever: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z of rim vertices at levers r (rows)."""
+    return (lever @ w) * float(w[2]) - float(w @ w) * lever[:, 2]
+
+
 def _identity_plus_axis(a: float, c: float, e3: np.ndarray) -> np.ndarray:
     """a 1 + c e3 e3ᵀ written out entry by entry, (a δ_ij) + c (e_i e_j), the operations
     of a * np.eye(3) + c * np.outer(e3, e3) (0.0 + … off the diagonal: −0.0 becomes 0.0
@@ -162,10 +167,6 @@ class BodyModel:
         Returns (gap (k,), normal (k,3), lever (k,3), vn (k,), noise (k,)) where `noise`
         is the roundoff level of the gap (a few ulps of the terms that form it)."""
         idx = np.arange(self.n_contacts) if idx is None else np.asarray(idx, dtype=int)
-        if not len(self.bumps):  # only rim vertices
-            return self._rim_contacts(y, self.vertices[idx])
-        if not self.n_rim:  # only bumps
-            return self._bump_contacts(y, self.bumps[idx])
         rim = idx < self.n_rim
         if rim.all():
             return self._rim_contacts(y, self.vertices[idx])
@@ -230,19 +231,15 @@ class BodyModel:
 
         rim vertex: (ω × (ω × r))_z = (ω·r) ω_z − |ω|² r_z.
         bump: 2 v·(ω × e3) + (x − b)·(ω × (ω × e3))."""
-        w = y[W]
         idx = np.arange(self.n_contacts) if idx is None else np.asarray(idx, dtype=int)
-        if not len(self.bumps):  # only rim vertices
-            return (lever @ w) * float(w[2]) - float(w @ w) * lever[:, 2]
-        if not self.n_rim:  # only bumps
-            return self._bump_bias(y, self.bumps[idx])
         rim = idx < self.n_rim
+        if rim.all():
+            return _rim_bias(lever, y[W])
+        if not rim.any():
+            return self._bump_bias(y, self.bumps[idx - self.n_rim])
         out = np.empty(len(idx))
-        if rim.any():
-            r = lever[rim]
-            out[rim] = (r @ w) * w[2] - float(w @ w) * r[:, 2]
-        if not rim.all():
-            out[~rim] = self._bump_bias(y, self.bumps[idx[~rim] - self.n_rim])
+        out[rim] = _rim_bias(lever[rim], y[W])
+        out[~rim] = self._bump_bias(y, self.bumps[idx[~rim] - self.n_rim])
         return out
 
     def _bump_bias(self, y: np.ndarray, pts: np.ndarray) -> np.ndarray:
