@@ -112,8 +112,9 @@ def _python_entry(function):
 
 
 def compiled_into_entry_points(module: str, qualname: str) -> bool:
-    """Whether a function numba compiles is one of this module's that only its entry
-    points call (`reference.core.ir_only`'s selection)."""
+    """Whether a function numba compiles is one of this module's not decorated
+    `_python_entry`: compiled into the entry points only (`reference.core.ir_only`'s
+    selection in `load_entry_points`)."""
     return module == __name__ and qualname not in PYTHON_ENTRY_POINTS
 
 
