@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 
 import numpy as np
 import pytest
@@ -118,6 +119,20 @@ def test_every_option_of_every_command_has_help():
         and not (action.help or "").strip()
     ]
     assert missing == []
+
+
+def test_every_options_help_states_its_default_once():
+    """The formatter appends "(default: …)"; a help text that also names the default
+    prints it twice."""
+    twice = []
+    for where, parser in every_parser(build_parser()):
+        formatter = parser._get_formatter()
+        for action in parser._actions:
+            if action.help and action.help != argparse.SUPPRESS:
+                text = formatter._get_help_string(action) % {"default": action.default}
+                if len(re.findall(r"\bdefault\b", text)) > 1:
+                    twice.append(f"{where} {action.option_strings}: {text}")
+    assert twice == []
 
 
 def test_help_shows_defaults_and_units(capsys):

@@ -275,15 +275,14 @@ def add_horizon(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="members of each horizon ensemble (reference runs: grid model at the run's dt, "
         "perturbed at its own error, perturbed at 1e-8 for the growth per impact); 0: no "
-        "horizon verdict (default 24)",
+        "horizon verdict",
     )
     p.add_argument(
         "--horizon-seed",
         type=int_in(0, 2**63 - 1),
         default=DEFAULT_SEED,
         metavar="SEED",
-        help="seed of the horizon ensembles (a member depends only on it and its number; "
-        "default 0)",
+        help="seed of the horizon ensembles (a member depends only on it and its number)",
     )
 
 
