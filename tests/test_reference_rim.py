@@ -77,7 +77,7 @@ def test_rim_at_gives_the_oracle_flights_axis_and_its_rate(seed):
             assert np.linalg.norm(second) <= cone[7] * (1 + 1e-3) + 1e-3
 
 
-# seeds 1 and 2 repeat seed 0's check on other flights (≈ 14 s of CPU each): `-m slow`
+# seeds 1 and 2 repeat seed 0's check on other flights (≈ 3 s each): `-m slow`
 RIM_SEEDS = [0, *(pytest.param(s, marks=pytest.mark.slow) for s in (1, 2))]
 
 
@@ -85,7 +85,7 @@ RIM_SEEDS = [0, *(pytest.param(s, marks=pytest.mark.slow) for s in (1, 2))]
 def test_rim_descent_never_passes_a_vertex_and_ends_near_the_ground(seed):
     """From states with the circle through a 100-gon's vertices clear of the ground
     (`rim_clear`), the descent's step keeps every vertex and the circle's lowest point
-    above the ground at 3,000 times over it on the oracle's flight, and in at least
+    above the ground at 1,000 times over it on the oracle's flight, and in at least
     95 % of the cases ends with that point within the four sags `rim_clear` allows (or
     at the horizon): where the vertices are examined."""
     from reference.core.rim import rim_clear, rim_descent
@@ -104,7 +104,9 @@ def test_rim_descent_never_passes_a_vertex_and_ends_near_the_ground(seed):
         depth = flight_bounds(y, fc, model, pts, math.inf).depth
         horizon = 5.0
         step = rim_descent(y, fc, model, depth, horizon, 0.0)
-        lowest, circle = _oracle_heights(scene, y, np.linspace(0.0, min(step, horizon), 3000))
+        # 1,000 times: a step 2 % too long fails on 59 of these 60 flights at 300 times as
+        # at 3,000 (the end of the step is where the body is lowest)
+        lowest, circle = _oracle_heights(scene, y, np.linspace(0.0, min(step, horizon), 1000))
         assert step > 0.0 and np.all(lowest > -1e-14) and np.all(circle > -1e-14)
         end = oracle_flight.free_flight(oracle_flight.flight_constants(body, y), step)
         e3 = qt.body_axis(end[3:7])

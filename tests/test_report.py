@@ -66,7 +66,8 @@ def results(tmp_path_factory):
         "stress": ["stress", "--case", "grazing", "--engine", "reference"],
     }
     runs["bench"] += ["--repeats", "1"]
-    runs["fidelity"] += ["--eps-grid", "1:1e-2:3"]
+    # horizon ensembles of 4 members, not 24: these tests read the document's fields
+    runs["fidelity"] += ["--eps-grid", "1:1e-2:3", "--horizon-runs", "4"]
     for kind, argv in runs.items():
         docs[kind] = root / f"{kind}.json"
         _harness_json(argv, docs[kind])
