@@ -111,9 +111,10 @@ $(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
 
 # pytest's bytecode of the test modules (their asserts rewritten), written once: each of
 # the tests' workers collects every test module, and without it each rewrites them all
-# (3 of the 7 s before a worker's first test).  After the core's build, on the core that
-# the build leaves idle while MJX's programs still compile on the other; a module that
-# cannot be collected is left to the tests, which report it.
+# (3 of the 7 s before a worker's first test).  After the core's build, at the lowest
+# priority: until the build ends both cores are busy (the build on one, the installs and
+# the warm-ups on the other).  A module that cannot be collected is left to the tests,
+# which report it.
 TESTS_COLLECTED := $(VENV)/.tests-collected
 $(TESTS_COLLECTED): $(STAMP_ALL) $(AOT) $(wildcard tests/*.py tests/*/*.py)
 	@echo "set-up 3/3, then: the test modules' bytecode (pytest --collect-only)"

@@ -162,6 +162,25 @@ def empty_output():
 MISSING_EXTRA = "engine extra missing"
 
 
+def harness_json(argv: list[str], out=None) -> dict:
+    """`harness ARGV --json` run in this process (`harness.cli.main`: the document a
+    separate process prints, without a new interpreter's imports); asserts exit 0 and
+    returns the document, also written to `out` when given."""
+    import contextlib
+    import io
+    import json
+
+    from harness.cli import main
+
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        rc = main([*argv, "--json"])
+    assert rc == 0, stderr.getvalue()
+    if out is not None:
+        out.write_text(stdout.getvalue())
+    return json.loads(stdout.getvalue())
+
+
 def require_extra(module: str, extra: str):
     """The module of an engine installed by the pip extra `extra`; the test (or the whole
     test module, at import) is skipped with a one-line reason when it is not installed.

@@ -5,8 +5,6 @@ elsewhere) and in a real browser (headless Chromium, when installed)."""
 from __future__ import annotations
 
 import base64
-import contextlib
-import io
 import json
 import shutil
 import subprocess
@@ -17,6 +15,7 @@ import pytest
 
 from harness.cli import main
 from harness.report import detect_kind
+from tests.conftest import harness_json
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -45,15 +44,6 @@ class Tags(HTMLParser):
         return [a for t, a in self.tags if t == name]
 
 
-def _harness_json(argv: list[str], out: Path) -> None:
-    """`harness ARGV --json > OUT`, run in this process (the commands' own `main`: the
-    same document a separate process writes, without a new interpreter's imports)."""
-    err = io.StringIO()
-    with open(out, "w") as fh, contextlib.redirect_stdout(fh), contextlib.redirect_stderr(err):
-        rc = main([*argv, "--json"])
-    assert rc == 0, err.getvalue()
-
-
 @pytest.fixture(scope="module")
 def results(tmp_path_factory):
     """One small result document of every kind (written as the commands write them)."""
@@ -70,11 +60,11 @@ def results(tmp_path_factory):
     runs["fidelity"] += ["--eps-grid", "1:1e-2:3", "--horizon-runs", "4"]
     for kind, argv in runs.items():
         docs[kind] = root / f"{kind}.json"
-        _harness_json(argv, docs[kind])
+        harness_json(argv, docs[kind])
     sweep_root = root / "sweep"
     argv = ["sweep", "exponent", "--gyration", "0.3:0.5:2", "--restitution", "0.3:0.6:2"]
     argv += ["--samples", "2", "--engine", "linear", "--workers", "1", "--out", str(sweep_root)]
-    _harness_json(argv, root / "sweep.json")
+    harness_json(argv, root / "sweep.json")
     docs["sweep"] = root / "sweep.json"
     docs["sweep_dir"] = sweep_root / "linear"
     return docs

@@ -15,20 +15,12 @@ from harness.cli import main
 from harness.report.links import file_href, link_problem
 from harness.text import terminal_safe
 from reference.scene import show_path
+from tests.conftest import harness_json
 
 
 @pytest.fixture(scope="module")
-def compare_doc(tmp_path_factory):
-    out = tmp_path_factory.mktemp("cmp") / "compare.json"
-    argv = ["compare", "pentagon-bounce", "--engine", "linear", "--t-end", "0.3", "--json"]
-    import contextlib
-    import io
-
-    buf = io.StringIO()
-    with contextlib.redirect_stdout(buf):
-        assert main(argv) == 0
-    out.write_text(buf.getvalue())
-    return json.loads(buf.getvalue())
+def compare_doc():
+    return harness_json(["compare", "pentagon-bounce", "--engine", "linear", "--t-end", "0.3"])
 
 
 def report(tmp_path, capsys, doc, raw: bytes | None = None):
