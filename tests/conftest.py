@@ -10,7 +10,6 @@ after the first, and a second worker of the same run, load them instead of compi
 
 from __future__ import annotations
 
-import gc
 import importlib
 import os
 
@@ -102,24 +101,6 @@ def pytest_collection_modifyitems(config, items) -> None:
     for item in items:
         if "fork_children" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"))
-
-
-# Full collections (generation 2) after collection: once per this many collections of
-# generation 1, instead of Python's 10.
-FULL_COLLECTION_EVERY = 1000
-
-
-def pytest_collection_finish(session) -> None:
-    """Python's cyclic garbage collector, set for a long test process: the objects
-    alive after collection (238,000: the modules the tests import, numba's and pandas'
-    among them, which live to the end) are frozen out of every later collection
-    (`gc.freeze`), and a full collection runs once per FULL_COLLECTION_EVERY collections
-    of generation 1 instead of every 10.  Measured over `make test`'s two workers: 7.0
-    CPU-s collecting garbage, 2.8 s with both (the largest process's peak memory 1.2 →
-    1.4 GB; docs/performance.md, "By kind")."""
-    gc.freeze()
-    young, middle, _ = gc.get_threshold()
-    gc.set_threshold(young, middle, FULL_COLLECTION_EVERY)
 
 
 @pytest.fixture
