@@ -13,13 +13,17 @@ from scipy.optimize import brentq
 from reference.core.roots import cubic_first_root, safe_step
 from reference.core.tolerances import ROOT_REL_TOL
 
+# the grid both root finders below look for the first sign change on: 400 points a
+# decade over 1e-20 … 1e6
+GRID = np.logspace(-20, 6, 26 * 400 + 1)
+GRID.flags.writeable = False
+
 
 def _first_positive_root(coeffs):
     """The first x > 0 where the polynomial c0 + c1 x + … (ascending, c0 > 0) changes
-    sign: the first sign change on a grid of 400 points a decade over 1e-20 … 1e6,
-    closed by brentq; inf if there is none."""
+    sign: the first sign change on GRID, closed by brentq; inf if there is none."""
     f = np.polynomial.Polynomial(coeffs)
-    xs = np.logspace(-20, 6, 26 * 400 + 1)
+    xs = GRID
     below = np.nonzero(f(xs) <= 0.0)[0]
     if below.size == 0:
         return math.inf
@@ -64,7 +68,7 @@ def _bounds_first_root(g, g1, g2, K, B):
     def m(x):
         return np.maximum(g + x * (g1 - 0.5 * K * x), g + x * (g1 + x * (0.5 * g2 - x * B / 6.0)))
 
-    xs = np.logspace(-20, 6, 26 * 400 + 1)
+    xs = GRID
     below = np.nonzero(m(xs) <= 0.0)[0]
     if below.size == 0:
         return math.inf
