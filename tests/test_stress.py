@@ -155,6 +155,25 @@ def test_unmatched_impacts_count_missed_and_spurious_in_any_order():
     assert S.assess(other, ref, flat_scene(), 1.0)["verdict"] == "failed"
 
 
+def test_candidate_pairs_are_every_pair_within_its_window_closest_first():
+    """unmatched_impacts' candidates (judge._closest_first) against every pair of the
+    two lists tried one by one: |t_run − t_ref| ≤ the reference impact's window, sorted
+    by that distance, then reference index, then run index; exact ties included (run
+    impacts at reference times) and zero windows."""
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        tr = np.sort(rng.uniform(0.0, 1.0, rng.integers(0, 25)))
+        te = np.sort(np.concatenate([rng.uniform(0.0, 1.0, rng.integers(0, 25)), tr[:3]]))
+        wr = rng.uniform(0.0, 0.1, tr.size) * (rng.random(tr.size) < 0.9)
+        ir = np.flatnonzero(rng.random(tr.size) < 0.7)
+        ie = np.flatnonzero(rng.random(te.size) < 0.7)
+        every = sorted(
+            (abs(te[j] - tr[i]), i, j) for i in ir for j in ie if abs(te[j] - tr[i]) <= wr[i]
+        )
+        want = [(int(i), int(j)) for _, i, j in every]
+        assert stress_judge._closest_first(tr, wr, ir, te, ie) == want
+
+
 def test_alpha_cases_start_at_their_inclination():
     cases = S.select_cases(["alpha"])
     assert [c.name for c in cases] == ["alpha-1e-3", "alpha-1e-6", "alpha-1e-9", "alpha-1e-12"]

@@ -29,7 +29,7 @@ from ..metrics import (
     RELATIVE_TIME_TOLERANCE,
     STEPS_TIME_TOLERANCE,
     chatter_tail,
-    slow_impact_speed,
+    chatter_tail_speed,
 )
 
 
@@ -52,8 +52,7 @@ class LeadingImpacts:
 
 def leading_impacts(reference: Trajectory, n: int, gravity: float) -> LeadingImpacts:
     """The reference's first `n` impacts that are not chatter tails (module docstring)."""
-    fastest = max((-e.v_normal_pre for e in reference.impacts), default=0.0)
-    speed = slow_impact_speed(None, gravity, max(fastest, 0.0))
+    speed = chatter_tail_speed(reference, gravity, None)
     tail = chatter_tail(reference, speed)
     idx = np.flatnonzero(~tail)[:n]
     if len(idx) == 0:

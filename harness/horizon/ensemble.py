@@ -24,7 +24,7 @@ import numpy as np
 from reference import Trajectory
 from reference.scene import Scene
 
-from ..metrics import ImpactMatch, match_impacts, match_tolerance, slow_impact_speed
+from ..metrics import ImpactMatch, chatter_tail_speed, match_impacts, match_tolerance
 from .grid import GridRun
 from .settings import DEFAULT_RUNS, DEFAULT_SEED
 from .state import displaced, lifted, post_impact_states, random_directions, run_from
@@ -63,12 +63,6 @@ def rematched(
 def matched(run: Trajectory, reference: Trajectory, gravity: float) -> ImpactMatch:
     """`compare`'s matching of run against reference (harness.metrics.match_impacts)."""
     return match_impacts(run, reference, match_tolerance(run, reference, gravity))
-
-
-def tail_speed(reference: Trajectory, gravity: float, dt: float | None) -> float:
-    """The chatter-tail speed of `compare` for a run at dt (metrics.slow_impact_speed)."""
-    fastest = max((-e.v_normal_pre for e in reference.impacts), default=0.0)
-    return slow_impact_speed(dt, gravity, max(fastest, 0.0))
 
 
 # ----------------------------------------------------------------------------- perturbed
@@ -162,7 +156,7 @@ def grid_ensemble(
 ) -> list[Member]:
     """`runs` grid-model runs at dt with phases uniform in [0, dt) (grid.py), each of
     at most `limit` impacts (grid_member)."""
-    tail = tail_speed(reference, scene.gravity, dt)
+    tail = chatter_tail_speed(reference, scene.gravity, dt)
     members = []
     for i in range(runs):
         phase = float(member_rng(seed, i).uniform(0.0, dt))

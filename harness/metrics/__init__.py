@@ -53,6 +53,7 @@ from .matching import (  # noqa: F401
     MatchTolerance,
     Mismatch,
     chatter_tail,
+    chatter_tail_speed,
     common_window,
     impact_time_error,
     impact_windows,

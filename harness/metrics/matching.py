@@ -114,11 +114,19 @@ def match_tolerance(run: Trajectory, reference: Trajectory, gravity: float) -> M
     instead of ending the match if it is a *tail* impact (`chatter_tail`: slower than
     tail_speed = `slow_impact_speed`(run.dt, g, fastest reference approach), at a contact
     already in the chatter episode).  A skipped impact is not counted as matched."""
-    fastest = max((-e.v_normal_pre for e in reference.impacts), default=0.0)
-    tail = slow_impact_speed(run.dt, gravity, max(fastest, 0.0))
+    tail = chatter_tail_speed(reference, gravity, run.dt)
     if run.dt is not None:
         return MatchTolerance(STEPS_TIME_TOLERANCE * float(run.dt), RELATIVE_TIME_TOLERANCE, tail)
     return MatchTolerance(EVENT_TIME_TOLERANCE, RELATIVE_TIME_TOLERANCE, tail)
+
+
+def chatter_tail_speed(reference: Trajectory, gravity: float, dt: float | None) -> float:
+    """The speed below which an impact of a run at step dt (None: event-driven) can be a
+    chatter tail (`chatter_tail`): `slow_impact_speed` of the reference's fastest
+    approach, max_i −v_pre,i (0 without impacts)."""
+    approach = -reference.impact_column("v_normal_pre")
+    fastest = float(approach.max()) if approach.size else 0.0
+    return slow_impact_speed(dt, gravity, max(fastest, 0.0))
 
 
 def impact_windows(reference: Trajectory, tolerance: MatchTolerance) -> np.ndarray:

@@ -8,7 +8,7 @@ import numpy as np
 
 from reference.trajectory import Trajectory
 
-from .matching import slow_impact_speed
+from .matching import chatter_tail_speed
 
 # ----------------------------------------------------------------------------- restitution
 
@@ -35,8 +35,7 @@ def effective_restitution(traj: Trajectory, gravity: float) -> RestitutionEstima
     the impact law)."""
     pre = traj.impact_column("v_normal_pre")
     post = traj.impact_column("v_normal_post")
-    fastest = float(np.max(-pre)) if pre.size else 0.0
-    v_min = slow_impact_speed(traj.dt, gravity, max(fastest, 0.0))
+    v_min = chatter_tail_speed(traj, gravity, traj.dt)
     use = pre < -v_min
     if not np.any(use):
         return RestitutionEstimate(None, None, None, 0, v_min)

@@ -131,18 +131,28 @@ def unmatched_impacts(
         ie = np.flatnonzero(keep_e & (ce == k))
         if not ir.size or not ie.size:
             continue
-        tek = te[ie]
-        pairs = []
-        for i in ir:
-            lo = np.searchsorted(tek, tr[i] - wr[i], side="left")
-            hi = np.searchsorted(tek, tr[i] + wr[i], side="right")
-            pairs += [(abs(tek[j] - tr[i]), i, ie[j]) for j in range(lo, hi)]
-        for _, i, j in sorted(pairs):
+        for i, j in _closest_first(tr, wr, ir, te, ie):
             if not used_r[i] and not used_e[j]:
                 used_r[i] = used_e[j] = True
     missed = int(np.sum(keep_r & ~used_r))
     spurious = int(np.sum(keep_e & ~used_e & (te <= t1)))
     return missed, spurious, int(np.sum(keep_r))
+
+
+def _closest_first(tr, wr, ir, te, ie) -> list[tuple[int, int]]:
+    """Every pair (i, j) of a reference impact i in `ir` and a run impact j in `ie` (one
+    contact's, each in time order) with |te[j] − tr[i]| ≤ wr[i], closest first (ties:
+    by i, then j)."""
+    tek = te[ie]
+    lo = np.searchsorted(tek, tr[ir] - wr[ir], side="left")
+    hi = np.searchsorted(tek, tr[ir] + wr[ir], side="right")
+    n = np.maximum(hi - lo, 0)
+    i = np.repeat(ir, n)
+    # the positions lo … hi − 1 in tek of each reference impact, one after the other
+    within = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    j = ie[np.repeat(lo, n) + within]
+    order = np.lexsort((j, i, np.abs(te[j] - tr[i])))
+    return list(zip(i[order].tolist(), j[order].tolist(), strict=True))
 
 
 def _impact_comparison(run: Trajectory, reference: Trajectory, scene: Scene) -> dict[str, Any]:
