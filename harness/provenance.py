@@ -20,6 +20,7 @@ short description of the machine (no host name).
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 from collections.abc import Sequence
@@ -31,9 +32,13 @@ PROGRAM = "harness"
 CORE_DISTRIBUTIONS = ("numpy", "scipy", "numba", "matplotlib")
 
 
+@functools.cache
 def distribution_version(distribution: str | None) -> str | None:
     """Installed version of a distribution from its metadata (nothing imported); None
-    for no name, "not installed" when it is missing."""
+    for no name, "not installed" when it is missing.  Read once per process: each read
+    searches the path and parses the distribution's METADATA file again (~20 ms for a
+    document's versions), and a process that runs several commands (the test suite
+    does) would repeat it for each."""
     if distribution is None:
         return None
     from importlib import metadata  # here: its import costs the command's start-up
