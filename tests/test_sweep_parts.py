@@ -12,7 +12,14 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from harness.sweep.parts import content_hash, part_bytes, part_name
+from harness.sweep.parts import (
+    SCHEMA,
+    checked_columns,
+    content_hash,
+    part_bytes,
+    part_name,
+    rows_mismatch,
+)
 from harness.sweep.store import StoreError, load_results
 from tests.test_sweep_heal import config, fake_chunk, stored_c, sweep
 
@@ -92,6 +99,31 @@ def test_rows_outside_the_grid_are_refused(finished):
     doc = sweep(out)
     assert doc["tasks"]["rows"] == 12 and stored_c(out) == c
     assert "rows off this sweep's grid: samples beyond 3" in doc["text"]
+
+
+@pytest.mark.parametrize(
+    ("change", "why"),
+    [
+        ({}, ""),
+        ({"engine": "mujoco"}, "engine ['mujoco'] (now 'linear')"),
+        ({"n": 4}, "n [4] (now 3)"),
+        ({"seed": 6}, "seed [6] (now 5)"),
+        ({"i_gyration": 2}, "grid indices beyond this grid"),
+        ({"i_restitution": -1}, "grid indices beyond this grid"),
+        ({"i_gyration": None}, "grid indices beyond this grid"),
+        ({"sample": 3}, "samples beyond 3"),
+        ({"gyration": 0.2 + 1e-12}, "other grid values"),
+        ({"restitution": None}, "other grid values"),
+        ({"dt": 1e-3}, "another dt"),
+    ],
+)
+def test_rows_off_the_grid_are_named_by_what_is_off(finished, change, why):
+    """Every row of a finished part with one field changed (a null: None), and the
+    reason `rows_mismatch` gives; the part as stored has none."""
+    out, _ = finished
+    rows = [r | change for r in rows_of(parts_of(out)[0])]
+    table = pa.Table.from_pylist(rows, schema=SCHEMA)
+    assert rows_mismatch(checked_columns(table), config()) == why
 
 
 def test_a_duplicate_part_that_sorts_first_is_refused_with_the_one_it_doubles(finished):

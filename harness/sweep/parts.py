@@ -29,6 +29,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
@@ -158,14 +159,14 @@ def verify_parts(parts_dir: Path, config: SweepConfig) -> tuple[pa.Table, list[R
         if bad is None and own != want:
             bad = Refused(path, "foreign", "parameters " + config_difference(own, want))
         if bad is None:
-            df = table.to_pandas()
-            mismatch = rows_mismatch(df, config)
+            rows = checked_columns(table)
+            mismatch = rows_mismatch(rows, config)
             if mismatch:
                 bad = Refused(path, "foreign", f"rows off this sweep's grid: {mismatch}")
         if bad is not None:
             refused.append(bad)
             continue
-        keys = list(zip(*(df[k].tolist() for k in KEY), strict=True))
+        keys = list(zip(*(rows[k].tolist() for k in KEY), strict=True))
         kept.append((path, table.replace_schema_metadata(None), keys))
     counts = Counter(k for _, _, keys in kept for k in keys)
     tables = []
@@ -178,21 +179,38 @@ def verify_parts(parts_dir: Path, config: SweepConfig) -> tuple[pa.Table, list[R
     return rows, refused
 
 
-def rows_mismatch(df, config: SweepConfig) -> str:
-    """Why stored rows cannot belong to `config` ('' when they all can): engine, n, seed,
-    indices within the grid, the grid values at those indices, and dt."""
-    if not len(df):
+# the columns `rows_mismatch` checks (KEY among them)
+CHECKED = ("engine", "n", "seed", *KEY, "gyration", "restitution", "dt")
+
+
+def checked_columns(table: pa.Table) -> dict[str, np.ndarray]:
+    """The CHECKED columns of a part's rows as numpy arrays (a null: None in `engine`,
+    NaN in the numbers), read without converting the part to a DataFrame."""
+    return {name: table.column(name).to_numpy(zero_copy_only=False) for name in CHECKED}
+
+
+def rows_mismatch(rows: dict[str, np.ndarray], config: SweepConfig) -> str:
+    """Why stored rows (`checked_columns`) cannot belong to `config` ('' when they all
+    can): engine, n, seed, indices within the grid, the grid values at those indices,
+    and dt."""
+    if not len(rows["engine"]):
         return ""
     for col, want in (("engine", config.engine), ("n", config.n), ("seed", config.seed)):
-        if not (df[col] == want).all():
-            return f"{col} {sorted(set(df[col].tolist()))[:3]} (now {want!r})"
+        if not (rows[col] == want).all():
+            return f"{col} {sorted(set(rows[col].tolist()))[:3]} (now {want!r})"
     rho, gam = config.rho_values, config.gamma_values
-    ir, ig, s = df["i_gyration"], df["i_restitution"], df["sample"]
-    if not (ir.between(0, len(rho) - 1).all() and ig.between(0, len(gam) - 1).all()):
+    ir, ig, s = rows["i_gyration"], rows["i_restitution"], rows["sample"]
+    if not (_within(ir, len(rho)) and _within(ig, len(gam))):
         return "grid indices beyond this grid"
-    if not s.between(0, config.samples - 1).all():
+    if not _within(s, config.samples):
         return f"samples beyond {config.samples}"
-    if not ((df["gyration"] == rho[ir]).all() and (df["restitution"] == gam[ig]).all()):
+    if not ((rows["gyration"] == rho[ir]).all() and (rows["restitution"] == gam[ig]).all()):
         return "other grid values"
-    dt_ok = df["dt"].isna().all() if config.dt is None else (df["dt"] == config.dt).all()
+    dt = rows["dt"]
+    dt_ok = np.isnan(dt).all() if config.dt is None else (dt == config.dt).all()
     return "" if dt_ok else "another dt"
+
+
+def _within(index: np.ndarray, size: int) -> bool:
+    """Every index in 0 … size − 1 (a NaN, a null, is not)."""
+    return bool(((index >= 0) & (index <= size - 1)).all())
