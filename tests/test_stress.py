@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from harness import stress as S
+from harness.metrics import match_tolerance
 from harness.stress import budget as stress_budget
 from harness.stress import cases as stress_cases
 from harness.stress import judge as stress_judge
@@ -146,7 +147,8 @@ def test_unmatched_impacts_count_missed_and_spurious_in_any_order():
     ref = level_run([H] * 11, [1.0] * 11, [hit(0.1, 0), hit(0.2, 1), hit(0.3, 0)], dt=None)
     # the run swaps nothing, shifts one hit by 1e-4 s (< 3 dt), misses 0 @ 0.3, adds 2 @ 0.25
     run = level_run([H] * 11, [1.0] * 11, [hit(0.1001, 0), hit(0.2, 1), hit(0.25, 2)])
-    assert stress_judge.unmatched_impacts(run, ref, gravity=1.0) == (1, 1, 3)
+    tol = match_tolerance(run, ref, gravity=1.0)
+    assert stress_judge.unmatched_impacts(run, ref, tol) == (1, 1, 3)
     row = S.assess(run, ref, flat_scene(), 1.0)
     assert row["missed_impacts"] == 1 and row["spurious_impacts"] == 1
     assert row["verdict"] == "degraded"

@@ -112,7 +112,7 @@ def match_tolerance(run: Trajectory, reference: Trajectory, gravity: float) -> M
     own threshold, an engine merges bounces shorter than a few steps into sustained
     contact.  Where the two sequences would next disagree, the earlier impact is skipped
     instead of ending the match if it is a *tail* impact (`chatter_tail`: slower than
-    tail_speed = `slow_impact_speed`(run.dt, g, fastest reference approach), at a contact
+    tail_speed = `chatter_tail_speed`(reference, g, run.dt), at a contact
     already in the chatter episode).  A skipped impact is not counted as matched."""
     tail = chatter_tail_speed(reference, gravity, run.dt)
     if run.dt is not None:

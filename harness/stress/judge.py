@@ -14,7 +14,14 @@ from reference.geometry import length_scale as state_length_scale
 from reference.scene import Scene
 from reference.trajectory import Status, Trajectory
 
-from ..metrics import chatter_tail, common_window, impact_windows, match_impacts, match_tolerance
+from ..metrics import (
+    MatchTolerance,
+    chatter_tail,
+    common_window,
+    impact_windows,
+    match_impacts,
+    match_tolerance,
+)
 
 # Verdict thresholds.  Energy gain relative to |E0|; penetration relative to L.
 FAILED_ENERGY_GAIN = 0.1
@@ -97,14 +104,14 @@ def length_scale(scene: Scene) -> float:
 
 
 def unmatched_impacts(
-    run: Trajectory, reference: Trajectory, gravity: float
+    run: Trajectory, reference: Trajectory, tol: MatchTolerance
 ) -> tuple[int, int, int] | None:
     """(missed, spurious, counted) impacts of `run` against `reference` over their
     common window; `counted` is the number of reference impacts that take part.
 
     One-to-one matching per contact, order-free: a run impact and a reference impact at
     the same contact match when |t_run − t_ref| ≤ the reference impact's window
-    (`metrics.impact_windows` with `metrics.match_tolerance`), closest pairs first.
+    (`metrics.impact_windows` with `tol`, `metrics.match_tolerance`), closest pairs first.
     Missed: reference impacts in the window left unmatched; spurious: run impacts in
     the window left unmatched (run impacts up to one window past its end may match, as
     in `metrics.match_impacts`).  Chatter-tail impacts (`metrics.chatter_tail`), which
@@ -115,7 +122,6 @@ def unmatched_impacts(
     if window is None:
         return None
     t0, t1 = window
-    tol = match_tolerance(run, reference, gravity)
     tr = reference.impact_times().astype(float)
     cr = reference.impact_contacts()
     wr = impact_windows(reference, tol)
@@ -159,11 +165,12 @@ def _impact_comparison(run: Trajectory, reference: Trajectory, scene: Scene) -> 
     """The impact fields of a row: unmatched counts (`unmatched_impacts`) and the
     in-order match of `metrics.match_impacts` against the reference."""
     row: dict[str, Any] = {}
-    counts = unmatched_impacts(run, reference, scene.gravity)
+    tol = match_tolerance(run, reference, scene.gravity)
+    counts = unmatched_impacts(run, reference, tol)
     if counts is not None:
         row["missed_impacts"], row["spurious_impacts"], counted = counts
         row["reference_impacts_counted"] = counted
-    m = match_impacts(run, reference, match_tolerance(run, reference, scene.gravity))
+    m = match_impacts(run, reference, tol)
     row["reference_impacts"] = m.n_reference
     row["impacts_matched"] = m.n_matched
     row["first_mismatch"] = m.reason

@@ -159,14 +159,14 @@ def verify_parts(parts_dir: Path, config: SweepConfig) -> tuple[pa.Table, list[R
         if bad is None and own != want:
             bad = Refused(path, "foreign", "parameters " + config_difference(own, want))
         if bad is None:
-            rows = checked_columns(table)
-            mismatch = rows_mismatch(rows, config)
+            columns = checked_columns(table)
+            mismatch = rows_mismatch(columns, config)
             if mismatch:
                 bad = Refused(path, "foreign", f"rows off this sweep's grid: {mismatch}")
         if bad is not None:
             refused.append(bad)
             continue
-        keys = list(zip(*(rows[k].tolist() for k in KEY), strict=True))
+        keys = list(zip(*(columns[k].tolist() for k in KEY), strict=True))
         kept.append((path, table.replace_schema_metadata(None), keys))
     counts = Counter(k for _, _, keys in kept for k in keys)
     tables = []
