@@ -259,6 +259,29 @@ def test_a_run_that_kills_its_worker_is_recorded_and_the_others_survive(tmp_path
     assert (others["status"] != "failed").all() and others["error"].isna().all()
 
 
+def half_second_chunk(chunk):
+    """Stand-in for run_chunk: half a second per chunk, no rows."""
+    time.sleep(0.5)
+    return []
+
+
+def test_a_local_pool_stopped_mid_sweep_leaves_no_thread_or_worker_running():
+    import multiprocessing as mp
+    import threading
+
+    from harness.sweep.executors import run_local
+    from harness.sweep.grid import all_keys, make_chunks
+
+    cfg = small_config(samples=4)
+    threads, children = set(threading.enumerate()), set(mp.active_children())
+    results = run_local(make_chunks(cfg, all_keys(cfg), 1), workers=1, fn=half_second_chunk)
+    next(results)  # one chunk done, the next ones in the pool's queue
+    results.close()  # as a signal or an error in the consumer does
+    # nothing of the pool is left for the interpreter's exit to race with
+    assert set(threading.enumerate()) - threads == set()
+    assert set(mp.active_children()) - children == set()
+
+
 # ----------------------------------------------------------------------------- SIGKILL
 
 SLOW_CLI = """

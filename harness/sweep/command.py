@@ -3,6 +3,7 @@ into its study directory, the comparison figures (package docstring: harness.swe
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from pathlib import Path
@@ -179,12 +180,18 @@ def exponent_sweep(
                 warm_up(config)
             results = sweep_exec.run_local(chunks, workers=workers, fn=run_fn)
         t_compute = time.perf_counter()
-        with progress_bar(
-            config.n_tasks,
-            f"sweep {config.engine}",
-            show=bar and bool(missing),
-            initial=len(done),
-        ) as pbar:
+        # closing: the executor stops (its pool shut down, its workers ended) as soon as
+        # the loop ends, on a signal or an error too, not whenever the generator is
+        # collected
+        with (
+            progress_bar(
+                config.n_tasks,
+                f"sweep {config.engine}",
+                show=bar and bool(missing),
+                initial=len(done),
+            ) as pbar,
+            contextlib.closing(results),
+        ):
             for chunk, rows in results:
                 store.write_part(rows, chunk.label)
                 for r in rows:

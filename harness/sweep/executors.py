@@ -72,16 +72,30 @@ def _note_thread_failure(args) -> None:
         _thread_failures.append(args.exc_value)
 
 
-def _stop(pool) -> None:
-    """Shut the pool down without waiting; a pool whose manager thread died cannot stop
-    its workers itself (they wait for work for ever, and the interpreter would wait for
-    them at exit), so they are terminated."""
-    running = _pool_running(pool)
+# Seconds to wait for a stopped pool's manager thread to end.
+POOL_JOIN_S = 30.0
+
+
+def _stop(pool, *, finished: bool) -> None:
+    """Shut the pool down and wait for its manager thread to end.
+
+    Unless the work is `finished` (a signal, an error, or the consumer stopped reading),
+    the workers are terminated first: their chunks' rows would be discarded, and a pool
+    whose manager thread died cannot stop its workers itself (they would wait for work
+    for ever, and the interpreter for them at exit).  The manager thread is joined here,
+    never left running: at interpreter exit concurrent.futures wakes every pool's manager
+    thread without the lock that guards its wake-up pipe, and on Python 3.11 that races
+    with a manager thread closing the pipe, which prints "OSError: [Errno 9] Bad file
+    descriptor" after the command's last line (CPython gh-125451, fixed in 3.12 and 3.13
+    only)."""
+    thread = getattr(pool, "_executor_manager_thread", None)
     processes = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    if not running:
+    if not finished or not _pool_running(pool):
         for process in processes:
             process.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    if thread is not None:
+        thread.join(POOL_JOIN_S)
 
 
 def _cannot_run(exc: BaseException | None = None) -> ExecutorError:
@@ -139,6 +153,7 @@ def run_local(
     inflight: dict = {}
     previous_hook = threading.excepthook
     threading.excepthook = _note_thread_failure
+    finished = False
     try:
         while queue or inflight:
             while queue and len(inflight) < limit:
@@ -152,7 +167,7 @@ def run_local(
                     inflight[pool.submit(fn, w.chunk)] = (w, pool)
                 except BrokenProcessPool:
                     queue.appendleft(w)
-                    pool.shutdown(wait=False, cancel_futures=True)
+                    _stop(pool, finished=False)
                     pool = new_pool()
                 except (RuntimeError, MemoryError) as exc:  # "can't start new thread"
                     raise _cannot_run(exc) from None
@@ -165,15 +180,18 @@ def run_local(
                     rows = fut.result()
                 except Exception as exc:
                     if isinstance(exc, BrokenProcessPool) and p is pool:
-                        pool.shutdown(wait=False, cancel_futures=True)
+                        _stop(pool, finished=False)
                         pool = new_pool()
                     rows = _after_failure(w, exc, queue)
                     if rows is None:
                         continue
                 yield w.chunk, rows
+        finished = True
     finally:
-        threading.excepthook = previous_hook
-        _stop(pool)
+        try:
+            _stop(pool, finished=finished)
+        finally:
+            threading.excepthook = previous_hook
 
 
 def check_scheduler(scheduler: str, timeout_s: float = 5.0) -> None:
