@@ -79,15 +79,15 @@ POOL_JOIN_S = 30.0
 def _stop(pool, *, finished: bool) -> None:
     """Shut the pool down and wait for its manager thread to end.
 
-    Unless the work is `finished` (a signal, an error, or the consumer stopped reading),
-    the workers are terminated first: their chunks' rows would be discarded, and a pool
-    whose manager thread died cannot stop its workers itself (they would wait for work
-    for ever, and the interpreter for them at exit).  The manager thread is joined here,
-    never left running: at interpreter exit concurrent.futures wakes every pool's manager
-    thread without the lock that guards its wake-up pipe, and on Python 3.11 that races
-    with a manager thread closing the pipe, which prints "OSError: [Errno 9] Bad file
-    descriptor" after the command's last line (CPython gh-125451, fixed in 3.12 and 3.13
-    only)."""
+    Unless every chunk is `finished` (a signal, an error, or a consumer that stops
+    reading ends the work early), the workers are terminated first: the rows of the
+    chunks they hold would be discarded, and a pool whose manager thread died cannot
+    stop its workers itself (they would wait for work for ever, and the interpreter for
+    them at exit).  The manager thread is joined here, never left running: at
+    interpreter exit concurrent.futures wakes every pool's manager thread without the
+    lock that guards its wake-up pipe, and on Python 3.11 that races with a manager
+    thread closing the pipe, which prints "OSError: [Errno 9] Bad file descriptor" after
+    the command's last line (CPython gh-125451, fixed in 3.12 and 3.13 only)."""
     thread = getattr(pool, "_executor_manager_thread", None)
     processes = list((getattr(pool, "_processes", None) or {}).values())
     if not finished or not _pool_running(pool):
