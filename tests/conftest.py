@@ -71,13 +71,19 @@ def tilted_spinning_state() -> np.ndarray:
     return y
 
 
-@pytest.fixture
-def no_sweep_figures(monkeypatch):
-    """Sweeps that skip their PNGs (2-3 s each): for tests of a sweep's input and
-    rows; the README commands test and test_sweep's resumed run draw the figures."""
+def without_sweep_figures(monkeypatch) -> None:
+    """Sweeps that skip their PNGs (2-3 s each): for tests of a sweep's input, its rows
+    or its document; the README commands test and test_sweep's resumed run draw the
+    figures."""
     import harness.sweep.plots
 
     monkeypatch.setattr(harness.sweep.plots, "make_sweep_figures", lambda *a, **k: {})
+
+
+@pytest.fixture
+def no_sweep_figures(monkeypatch):
+    """`without_sweep_figures` for one test."""
+    without_sweep_figures(monkeypatch)
 
 
 @pytest.fixture

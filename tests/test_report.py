@@ -15,7 +15,7 @@ import pytest
 
 from harness.cli import main
 from harness.report import detect_kind
-from tests.conftest import harness_json
+from tests.conftest import harness_json, without_sweep_figures
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -64,7 +64,10 @@ def results(tmp_path_factory):
     sweep_root = root / "sweep"
     argv = ["sweep", "exponent", "--gyration", "0.3:0.5:2", "--restitution", "0.3:0.6:2"]
     argv += ["--samples", "2", "--engine", "linear", "--workers", "1", "--out", str(sweep_root)]
-    harness_json(argv, root / "sweep.json")
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        # the report draws the sweep's map from its document, not from the sweep's PNGs
+        without_sweep_figures(monkeypatch)
+        harness_json(argv, root / "sweep.json")
     docs["sweep"] = root / "sweep.json"
     docs["sweep_dir"] = sweep_root / "linear"
     return docs
