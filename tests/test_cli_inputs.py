@@ -201,7 +201,11 @@ def test_a_directory_or_device_is_not_a_scene(cli, tmp_path):
 
 @pytest.fixture
 def no_run(monkeypatch):
-    """Fail the test if any simulation, bench, sweep run or figure starts."""
+    """Fail the test if any simulation, bench, sweep run or figure starts.  Each
+    function's code is replaced, not a module's name for it: the modules that import it
+    by name (`from ..simulators import run_simulator`) hold the function itself, so a
+    name replaced in its own module would not reach them, and one imported during the
+    test would keep the replacement after it."""
 
     def forbidden(*a, **k):
         raise AssertionError("the work started although an output was refused")
@@ -211,10 +215,14 @@ def no_run(monkeypatch):
     import harness.simulators
     import harness.sweep.run
 
-    monkeypatch.setattr(harness.simulators, "run_simulator", forbidden)
-    monkeypatch.setattr(harness.bench, "bench", forbidden)
-    monkeypatch.setattr(harness.figures, "make_figures", forbidden)
-    monkeypatch.setattr(harness.sweep.run, "run_chunk", forbidden)
+    work = (
+        harness.simulators.run_simulator,
+        harness.bench.bench,
+        harness.figures.make_figures,
+        harness.sweep.run.run_chunk,
+    )
+    for function in work:
+        monkeypatch.setattr(function, "__code__", forbidden.__code__)
 
 
 KEEP = {"keep.toml": TRIANGLE}
