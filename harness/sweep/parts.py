@@ -116,7 +116,7 @@ def read_part(path: Path) -> tuple[pa.Table | None, dict | None, Refused | None]
     if content_hash(data) != match.group(1):
         return None, None, Refused(path, "corrupt", "its bytes do not match its hash")
     try:
-        table = pq.read_table(pa.BufferReader(data))
+        table = pq.ParquetFile(pa.BufferReader(data)).read()  # one file: no dataset layer
     except (pa.ArrowException, OSError, ValueError) as exc:
         return None, None, Refused(path, "corrupt", f"not Parquet: {exc}"[:120])
     if table.schema.remove_metadata() != SCHEMA:
