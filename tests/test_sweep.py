@@ -178,21 +178,6 @@ def test_cli_reports_bad_sweep_input_as_exit_status_2(tmp_path, capsys, no_sweep
     assert "samples=1 (now 2)" in err and "Traceback" not in err
 
 
-def test_a_part_without_a_newer_column_reads_with_nulls_there(tmp_path):
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    from harness.sweep.store import SCHEMA, read_parts
-
-    old = pa.table({"sample": pa.array([4], pa.int32()), "c": [1.25], "status": ["singularity"]})
-    pq.write_table(old, tmp_path / "part-old.parquet")
-    (tmp_path / ".tmp-x-part-new.parquet").write_bytes(b"half written")  # ignored
-    t = read_parts(tmp_path)
-    assert t.schema == SCHEMA and t.num_rows == 1
-    row = t.to_pylist()[0]
-    assert row["sample"] == 4 and row["c"] == 1.25 and row["cpu_time_s"] is None
-
-
 def test_a_second_writer_is_refused_while_the_first_holds_the_lock(tmp_path):
     cfg = small_config()
     with SweepStore(tmp_path, cfg):

@@ -35,7 +35,6 @@ import time
 from pathlib import Path
 
 import pyarrow as pa
-import pyarrow.dataset as ds
 
 from ..outputs import (
     OutputError,
@@ -249,37 +248,6 @@ class SweepStore:
     # -- reading -------------------------------------------------------------------
     def part_paths(self) -> list[Path]:
         return sorted(self.parts_dir.glob("part-*.parquet"))
-
-
-def scan_parts(parts_dir: str | Path) -> tuple[pa.Table, list[Path]]:
-    """(all rows of the readable parts, the parts that cannot be read).  One dataset scan
-    (threaded) when every part reads; else part by part, to find the damaged ones.
-    Columns a part lacks (written before the column was added) come back as nulls."""
-    paths = sorted(Path(parts_dir).glob("part-*.parquet"))
-    if not paths:
-        return SCHEMA.empty_table(), []
-    try:
-        return _dataset(paths).to_table(), []
-    except (pa.ArrowException, OSError, ValueError):
-        pass
-    good, bad = [], []
-    for p in paths:
-        try:
-            _dataset([p]).to_table()
-            good.append(p)
-        except (pa.ArrowException, OSError, ValueError):
-            bad.append(p)
-    return (_dataset(good).to_table() if good else SCHEMA.empty_table()), bad
-
-
-def _dataset(paths: list[Path]):
-    return ds.dataset([str(p) for p in paths], format="parquet", schema=SCHEMA)
-
-
-def read_parts(parts_dir: str | Path) -> pa.Table:
-    """All rows of a sweep directory's readable parts (empty table with the schema if
-    none)."""
-    return scan_parts(parts_dir)[0]
 
 
 def _frame(table: pa.Table):
