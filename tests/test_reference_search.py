@@ -371,5 +371,8 @@ def test_direction_angle_is_atan2_within_its_error_bound():
     t = 2.0 - math.sqrt(3.0)  # tan(π/12), where the reduction starts
     edges = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1), (1, t),
              (t, 1), (-1, -t), (1, 1e-300), (-1e-300, 1)]  # fmt: skip
-    worst = max(abs(direction_angle(x, y) - math.atan2(y, x)) for x, y in [*xs, *edges])
+    # as floats, the argument types the search passes (an int would compile another
+    # specialisation)
+    points = [*xs, *((float(x), float(y)) for x, y in edges)]
+    worst = max(abs(direction_angle(x, y) - math.atan2(y, x)) for x, y in points)
     assert worst <= ANGLE_ERROR
