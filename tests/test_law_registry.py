@@ -24,11 +24,15 @@ ROOT = Path(__file__).resolve().parent.parent
 SECTION = "### Adding an impact law"
 
 
+# the sequential law's cap on single impacts, in the scratch and in the core's call alike
+MAX_HITS = 1000
+
+
 def _work(k, law=None):
     """The law's scratch for k contacts (its entry's work_size; 2k floats by default)."""
     vec = np.zeros(laws.work_floats(law, k) if law is not None else 2 * k)
     return LawWork(np.zeros((k, k)), vec, np.zeros(k, dtype=np.int64),
-                   np.zeros(0, dtype=np.int64), 0, 1000)  # fmt: skip
+                   np.zeros(0, dtype=np.int64), 0, MAX_HITS)  # fmt: skip
 
 
 def _system(seed=0, k=3):
@@ -71,7 +75,7 @@ def test_the_scene_the_cli_and_branches_read_the_registry():
         assert law.help in laws.law_help()
 
 
-def _impact_through_the_core(scene, law, max_hits):
+def _impact_through_the_core(scene, law):
     """The compiled core's multi-contact impact (`multi_impact`, the path the event loop
     runs: its law dispatch included) on every contact of `scene`, the body tilted and
     falling: (W, u⁻, λ, u⁺, status, whether the bounces were completed)."""
@@ -91,7 +95,7 @@ def _impact_through_the_core(scene, law, max_hits):
     no_order = np.zeros(0, dtype=np.int64)
     function("multi_impact")(
         y, model_record(scene), pts, law.code, np.arange(k, dtype=np.int64), k, no_order, 0,
-        max_hits, 1e-6, W, u_pre, lam, u_post, chol, vec, active, result,
+        MAX_HITS, 1e-6, W, u_pre, lam, u_post, chol, vec, active, result,
     )  # fmt: skip
     return W, u_pre, lam, u_post, result[0], bool(result[2])
 
@@ -101,7 +105,7 @@ def test_the_dispatch_reaches_each_registered_law_by_its_code():
 
     scene = as_scene("triangle-chatter")
     for law in laws.resolving_laws():
-        W, u, lam, u_post, status, completed = _impact_through_the_core(scene, law, 1000)
+        W, u, lam, u_post, status, completed = _impact_through_the_core(scene, law)
         assert status == SETTLED and (u < 0).all()
         gamma = 0.0 if completed else scene.restitution
         lam2, u_post2 = np.zeros(len(u)), np.zeros(len(u))
