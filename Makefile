@@ -35,7 +35,8 @@ $(BUILD_DEPS): pyproject.toml
 	@echo "  is built with ($(BUILD_REQUIRES)); Python:"
 	@echo "  $(PYTHON)"
 	$(PYTHON) -m venv $(if $(PIP_CAN_TARGET),--without-pip) $(VENV)
-	$(VENV_PIP) install --progress-bar off --no-compile $(BUILD_REQUIRES)
+	$(GET_INSTALLER)
+	$(INSTALL) $(BUILD_REQUIRES)
 	touch $(BUILD_DEPS)
 
 # The venv is made without pip (ensurepip takes 6 s, all on the set-up's longest path)
@@ -47,25 +48,42 @@ PIP_CAN_TARGET = $(eval PIP_CAN_TARGET := $(shell $(PYTHON) -m pip --python $(PY
 	> /dev/null 2>&1 && echo yes))$(PIP_CAN_TARGET)
 VENV_PIP = $(if $(PIP_CAN_TARGET),$(PYTHON) -m pip --python $(BIN)/python,$(BIN)/pip)
 
-# Beside the core's build, not before it: the venv's own pip, current (installed, or
-# brought up to date), and the build's requirements byte-compiled (pip's --no-compile
-# above: 7.5 of their 12.7 s install)
-BESIDE_BUILD = $(VENV_PIP) install --progress-bar off --upgrade pip && \
-	$(BIN)/python -m compileall -q $(VENV)/lib
-
-# The packages are installed without their bytecode (pip's --no-compile): pip would
-# byte-compile all 12,000 of their modules (42 CPU-s); the ~3,000 that the project and
-# its tests import are compiled by the set-up step after the install
-# (tests/warm_bytecode.py) or where first imported, and their bytecode written then, so
-# that every later process reads them compiled.
-LAZY_BYTECODE := --no-compile
+# The installer: uv (pip installs it into the venv; `uv pip install`), or pip with
+# `make setup INSTALLER=pip`.  uv installs every extra in 13 s where pip takes 31 s on an
+# idle machine and 42-46 s beside the core's build, and the set-up ends about 15 s
+# sooner (docs/performance.md).  uv reads none of pip's configuration (pip.conf,
+# PIP_INDEX_URL): where packages must come from an index set there, use INSTALLER=pip,
+# or uv's own UV_INDEX_URL.
+# Both install the packages without their bytecode (uv by default, pip with
+# --no-compile): pip would byte-compile all 12,000 of their modules (42 CPU-s); the
+# ~3,000 that the project and its tests import are compiled by the set-up step after the
+# install (tests/warm_bytecode.py) or where first imported, and their bytecode written
+# then, so that every later process reads them compiled.
+INSTALLER ?= uv
+ifeq ($(INSTALLER),uv)
+GET_INSTALLER = $(VENV_PIP) install --progress-bar off --no-compile 'uv>=0.5'
+INSTALL = $(BIN)/uv pip install --python $(BIN)/python
+INSTALL_PACKAGES = $(INSTALL)
+# beside the core's build: the venv's own pip, for the user's later installs
+BESIDE_BUILD = $(INSTALL) pip
+else ifeq ($(INSTALLER),pip)
+GET_INSTALLER = @:
+INSTALL = $(VENV_PIP) install --progress-bar off --no-compile
+INSTALL_PACKAGES = $(BIN)/pip install --progress-bar off --no-compile
+# beside the core's build, not before it: the venv's own pip, current (installed, or
+# brought up to date), and the build's requirements byte-compiled (--no-compile above:
+# 7.5 of their 12.7 s install)
+BESIDE_BUILD = $(INSTALL) --upgrade pip && $(BIN)/python -m compileall -q $(VENV)/lib
+else
+$(error INSTALLER is uv or pip, not '$(INSTALLER)')
+endif
 
 # the package and its core dependencies: the demo's needs
 $(STAMP): $(BUILD_DEPS)
 	@echo "set-up 3/3: the package and its core dependencies (MuJoCo, PyBullet, rerun, ...),"
 	@echo "  beside step 2/3"
 	$(BESIDE_BUILD)
-	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off $(LAZY_BYTECODE) -e .
+	$(NO_CORE_BUILD) $(INSTALL_PACKAGES) -e .
 	touch $(STAMP)
 
 # every extra ([all]: drake, dart, mjx, dask) and the dev tools
@@ -73,7 +91,7 @@ $(STAMP_ALL): $(BUILD_DEPS)
 	@echo "set-up 3/3: the package, every extra (Drake, DART, MJX, dask) and the dev tools"
 	@echo "  (2.5 GB in all), beside step 2/3"
 	$(BESIDE_BUILD)
-	$(NO_CORE_BUILD) $(BIN)/pip install --progress-bar off $(LAZY_BYTECODE) -e '.[all,dev]'
+	$(NO_CORE_BUILD) $(INSTALL_PACKAGES) -e '.[all,dev]'
 	touch $(STAMP) $(STAMP_ALL)
 
 $(AOT): $(BUILD_DEPS) $(CORE)
@@ -111,12 +129,13 @@ $(JAX_WARM): $(STAMP_ALL) engines/mjx.py tests/warm_mjx.py
 
 # pytest's bytecode of the test modules (their asserts rewritten), written once: each of
 # the tests' workers collects every test module, and without it each rewrites them all
-# (3 of the 7 s before a worker's first test).  After the core's build, at the lowest
-# priority: until the build ends both cores are busy (the build on one, the installs and
-# the warm-ups on the other).  A module that cannot be collected is left to the tests,
-# which report it.
+# (3 of the 7 s before a worker's first test).  After the installed modules' bytecode
+# (it imports them too), at the lowest priority, on whichever core is free first: after
+# the warm-ups on the second core when they end before the core's build (uv), else on
+# the build's core once the build is done (pip).  A module that cannot be collected is
+# left to the tests, which report it.
 TESTS_COLLECTED := $(VENV)/.tests-collected
-$(TESTS_COLLECTED): $(STAMP_ALL) $(AOT) $(wildcard tests/*.py tests/*/*.py)
+$(TESTS_COLLECTED): $(STAMP_ALL) $(BYTECODE_WARM) $(wildcard tests/*.py tests/*/*.py)
 	@echo "set-up 3/3, then: the test modules' bytecode (pytest --collect-only)"
 	-nice -n 19 $(BIN)/python -m pytest --collect-only -q -p no:cacheprovider > /dev/null
 	touch $(TESTS_COLLECTED)
