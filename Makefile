@@ -41,7 +41,8 @@ $(BUILD_DEPS): pyproject.toml
 
 # The venv is made without pip (ensurepip takes 6 s, all on the set-up's longest path)
 # where the system's pip can install into it (`pip --python`, pip >= 22.3): that pip
-# installs the build's requirements and then, beside the build, the venv's own pip.
+# installs uv into it (INSTALLER=pip: the build's requirements and then, beside the
+# build, the venv's own pip).
 # (asked once, when first needed, and passed on to the make that runs the steps side by
 # side: asked there, make would ask while the core's build waits to start)
 PIP_CAN_TARGET = $(eval PIP_CAN_TARGET := $(shell $(PYTHON) -m pip --python $(PYTHON) --version \
@@ -50,8 +51,8 @@ VENV_PIP = $(if $(PIP_CAN_TARGET),$(PYTHON) -m pip --python $(BIN)/python,$(BIN)
 
 # The installer: uv (pip installs it into the venv; `uv pip install`), or pip with
 # `make setup INSTALLER=pip`.  uv installs every extra in 13 s where pip takes 31 s on an
-# idle machine and 42-46 s beside the core's build, and the set-up ends about 15 s
-# sooner (docs/performance.md).  uv reads none of pip's configuration (pip.conf,
+# idle machine and 42-46 s beside the core's build, and the set-up ends 15-20 s sooner
+# (docs/performance.md).  uv reads none of pip's configuration (pip.conf,
 # PIP_INDEX_URL): where packages must come from an index set there, use INSTALLER=pip,
 # or uv's own UV_INDEX_URL.
 # Both install the packages without their bytecode (uv by default, pip with

@@ -4,6 +4,7 @@ unknown installer is refused before anything runs."""
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -15,11 +16,18 @@ ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.skipif(shutil.which("make") is None, reason="no make here")
 
 
+# what a make that runs the tests passes on to the makes they start (`make test
+# INSTALLER=pip` sets INSTALLER in MAKEFLAGS): left out, so that the defaults are tested
+MAKE_ENVIRONMENT = ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "INSTALLER")
+
+
 def make_setup(tmp_path, *args) -> subprocess.CompletedProcess:
     """`make setup` with the venv in tmp_path (every step is then due)."""
+    env = {k: v for k, v in os.environ.items() if k not in MAKE_ENVIRONMENT}
     return subprocess.run(
         ["make", "--no-print-directory", "setup", f"VENV={tmp_path / 'venv'}", *args],
         cwd=ROOT,
+        env=env,
         capture_output=True,
         text=True,
         timeout=60,
