@@ -34,6 +34,7 @@ $(BUILD_DEPS): pyproject.toml
 	@echo "set-up 1/3: a virtual environment in $(VENV) and what the reference's compiled core"
 	@echo "  is built with ($(BUILD_REQUIRES)); Python:"
 	@echo "  $(PYTHON)"
+	@echo "  installer: $(INSTALLER_NOTE)"
 	$(PYTHON) -m venv $(if $(PIP_CAN_TARGET),--without-pip) $(VENV)
 	$(GET_INSTALLER)
 	$(INSTALL) $(BUILD_REQUIRES)
@@ -65,12 +66,15 @@ ifeq ($(INSTALLER),uv)
 GET_INSTALLER = $(VENV_PIP) install --progress-bar off --no-compile 'uv>=0.5'
 INSTALL = $(BIN)/uv pip install --python $(BIN)/python
 INSTALL_PACKAGES = $(INSTALL)
+# printed at the set-up's start, so that a failed install is read beside it
+INSTALLER_NOTE = uv (it reads none of pip's configuration; INSTALLER=pip installs with pip)
 # beside the core's build: the venv's own pip, for the user's later installs
 BESIDE_BUILD = $(INSTALL) pip
 else ifeq ($(INSTALLER),pip)
 GET_INSTALLER = @:
 INSTALL = $(VENV_PIP) install --progress-bar off --no-compile
 INSTALL_PACKAGES = $(BIN)/pip install --progress-bar off --no-compile
+INSTALLER_NOTE = pip (INSTALLER=pip; without it, uv installs)
 # beside the core's build, not before it: the venv's own pip, current (installed, or
 # brought up to date), and the build's requirements byte-compiled (--no-compile above:
 # 7.5 of their 12.7 s install)
