@@ -50,11 +50,13 @@ def test_the_default_installer_is_uv_installed_by_pip(tmp_path):
     assert any(line.endswith("-e '.[all,dev]'") for line in by_uv)
 
 
-def test_the_set_up_names_its_installer_first(tmp_path):
+def test_the_set_up_names_its_installer_before_it_installs(tmp_path):
     for args, installer in (((), "uv"), (("INSTALLER=pip",), "pip")):
-        run = make_setup(tmp_path, "-n", *args)
-        echoed = [line for line in run.stdout.splitlines() if line.startswith("echo ")]
-        assert echoed[3].startswith(f'echo "  installer: {installer} (')
+        lines = make_setup(tmp_path, "-n", *args).stdout.splitlines()
+        named = [i for i, line in enumerate(lines) if line.startswith('echo "  installer: ')]
+        first_install = min(i for i, line in enumerate(lines) if " install " in line)
+        assert named and named[0] < first_install
+        assert lines[named[0]].startswith(f'echo "  installer: {installer} (')
 
 
 def test_installer_pip_installs_every_package_with_pip(tmp_path):
