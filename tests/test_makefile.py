@@ -34,12 +34,20 @@ def make_setup(tmp_path, *args) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.fixture(scope="module")
+def dry_runs(tmp_path_factory) -> dict[str, subprocess.CompletedProcess]:
+    """`make -n setup` with each installer (the default, then INSTALLER=pip), run once for
+    this file's tests (each reads the make files and asks pip a question: ~2 s)."""
+    venv = tmp_path_factory.mktemp("dry")
+    return {"uv": make_setup(venv, "-n"), "pip": make_setup(venv, "-n", "INSTALLER=pip")}
+
+
 def install_lines(out: str) -> list[str]:
     return [line for line in out.splitlines() if " install " in line]
 
 
-def test_the_default_installer_is_uv_installed_by_pip(tmp_path):
-    run = make_setup(tmp_path, "-n")
+def test_the_default_installer_is_uv_installed_by_pip(dry_runs):
+    run = dry_runs["uv"]
     assert run.returncode == 0, run.stderr
     lines = install_lines(run.stdout)
     uv_by_pip = [line for line in lines if "'uv>=0.5'" in line]
@@ -50,17 +58,17 @@ def test_the_default_installer_is_uv_installed_by_pip(tmp_path):
     assert any(line.endswith("-e '.[all,dev]'") for line in by_uv)
 
 
-def test_the_set_up_names_its_installer_before_it_installs(tmp_path):
-    for args, installer in (((), "uv"), (("INSTALLER=pip",), "pip")):
-        lines = make_setup(tmp_path, "-n", *args).stdout.splitlines()
+def test_the_set_up_names_its_installer_before_it_installs(dry_runs):
+    for installer, run in dry_runs.items():
+        lines = run.stdout.splitlines()
         named = [i for i, line in enumerate(lines) if line.startswith('echo "  installer: ')]
         first_install = min(i for i, line in enumerate(lines) if " install " in line)
         assert named and named[0] < first_install
         assert lines[named[0]].startswith(f'echo "  installer: {installer} (')
 
 
-def test_installer_pip_installs_every_package_with_pip(tmp_path):
-    run = make_setup(tmp_path, "-n", "INSTALLER=pip")
+def test_installer_pip_installs_every_package_with_pip(dry_runs):
+    run = dry_runs["pip"]
     assert run.returncode == 0, run.stderr
     lines = install_lines(run.stdout)
     assert lines and not any("uv" in line for line in lines)
