@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import sys
 
 import numpy as np
 import pytest
@@ -107,6 +108,18 @@ def pytest_collection_modifyitems(config, items) -> None:
     for item in items:
         if "fork_children" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.filterwarnings("ignore:os.fork:RuntimeWarning"))
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_unconfigure(config) -> None:
+    """A test worker (pytest-xdist) ends its process once its run is over: it has sent
+    its results (`workerfinished`, at the end of the session) and every plugin has
+    unconfigured.  Python's own teardown of a worker's modules (numba's, LLVM's, JAX's,
+    Drake's state) takes 1-2 s, while the run waits for its last worker to exit."""
+    if hasattr(config, "workerinput"):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)
 
 
 @pytest.fixture
