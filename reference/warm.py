@@ -11,8 +11,9 @@ from the cache instead of compiling it again.  The run's result is discarded."""
 from __future__ import annotations
 
 import dataclasses
-import sys
 import time
+
+from .process_exit import exit_now
 
 WARM_SCENE = "triangle-chatter"  # a built-in scene with a simultaneous impact
 WARM_LAW = "moreau"
@@ -38,4 +39,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_now(main())

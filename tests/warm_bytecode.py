@@ -21,6 +21,8 @@ import sys
 import time
 from pathlib import Path
 
+from reference.process_exit import exit_now
+
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE_FOLDERS = ("harness", "reference", "engines", "tests")
 
@@ -82,4 +84,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_now(main())

@@ -16,11 +16,12 @@ from __future__ import annotations
 import dataclasses
 import importlib.util
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
+
+from reference.process_exit import exit_now
 
 JAX_CACHE_DIR = Path(__file__).resolve().parents[1] / ".cache" / "jax"
 SCENE = "pentagon-bounce"  # MJX's tests' scene
@@ -68,4 +69,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_now(main())

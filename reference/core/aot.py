@@ -23,6 +23,8 @@ from pathlib import Path
 
 from numba import from_dtype, types
 
+from ..process_exit import exit_now
+
 CORE_DIR = Path(__file__).resolve().parent
 
 
@@ -211,16 +213,6 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     build_or_explain()
     return 0
-
-
-def exit_now(status: int) -> None:
-    """End the build's process without Python's teardown: the process holds numba's and
-    LLVM's state for the whole core, whose teardown takes ~2 s at the end of the
-    set-up's longest path, and nothing is left to write (the module, its stamp and
-    numba's cache entries are written and closed)."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(status)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,5 @@
-"""`python -m reference.core.aot`, the set-up's build step, as a command: it ends its
-process without Python's teardown (`aot.exit_now`), its output written and its status
-kept."""
+"""The set-up's steps end their processes without Python's teardown
+(reference.process_exit.exit_now), their output written and their status kept."""
 
 from __future__ import annotations
 
@@ -26,7 +25,7 @@ def run_python(code: str) -> subprocess.CompletedProcess:
 
 def test_exit_now_writes_what_is_buffered_and_exits_with_the_status():
     run = run_python(
-        "import sys; from reference.core.aot import exit_now; "
+        "import sys; from reference.process_exit import exit_now; "
         "sys.stdout.write('out, unflushed'); sys.stderr.write('err, unflushed'); exit_now(3)"
     )
     assert (run.returncode, run.stdout, run.stderr) == (3, "out, unflushed", "err, unflushed")
