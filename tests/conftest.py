@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import importlib
 import os
-import sys
 
 import numpy as np
 import pytest
 
 from reference import quaternion as qt
+from reference.process_exit import exit_now
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
 from tests.schedule import JAX_AT_COLLECTION, jax_loaded, ordered
 from tests.warm_mjx import JAX_CACHE_DIR
@@ -117,9 +117,7 @@ def pytest_unconfigure(config) -> None:
     unconfigured.  Python's own teardown of a worker's modules (numba's, LLVM's, JAX's,
     Drake's state) takes 1-2 s, while the run waits for its last worker to exit."""
     if hasattr(config, "workerinput"):
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(0)
+        exit_now(0)
 
 
 @pytest.fixture
