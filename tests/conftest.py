@@ -112,9 +112,9 @@ def pytest_collection_modifyitems(config, items) -> None:
 
 @pytest.hookimpl(trylast=True)
 def pytest_unconfigure(config) -> None:
-    """A test worker (pytest-xdist) ends its process once its run is over: it has sent
-    its results (`workerfinished`, at the end of the session) and every plugin has
-    unconfigured.  Python's own teardown of a worker's modules (numba's, LLVM's, JAX's,
+    """A test worker (pytest-xdist) ends its process once its tests are over: it has sent
+    its results (xdist's `workerfinished` event, after its last test) and every plugin
+    has unconfigured.  Python's own teardown of a worker's modules (numba's, LLVM's, JAX's,
     Drake's state) takes 1-2 s, while the run waits for its last worker to exit."""
     if hasattr(config, "workerinput"):
         exit_now(0)
