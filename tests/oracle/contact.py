@@ -19,19 +19,40 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from . import quaternion as qt
-from .body import BodyModel, Q, V, W, X
+from .body import BodyModel, Contact, Q, State, V, W, X, row_dot, solve, state
+
+
+def held_system(model: BodyModel, s: State, contacts) -> tuple[list[Contact], list, list, list]:
+    """(contacts, A, b, acc_free) for the contacts held at state s, as floats: their
+    kinematics, A = J M⁻¹ Jᵀ, b = J M⁻¹ f + bias and M⁻¹ f (gravity and the gyroscopic
+    term)."""
+    cs = model.contact_list(s, contacts)
+    acc_free = model.free_acc(s)
+    lin, ang = acc_free[:3], acc_free[3:]
+    b = [row_dot(c, lin, ang) + c.bias for c in cs]
+    return cs, model.delassus(s, cs), b, acc_free
+
+
+def held_motion(model: BodyModel, s: State, contacts) -> tuple[list[float], list[float]]:
+    """([v̇; ω̇], λ) with the contacts held as bilateral constraints (eqs. rollF, rollM,
+    rollc): λ = −A⁻¹ b, [v̇; ω̇] = M⁻¹ f + M⁻¹ Jᵀ λ (floats)."""
+    cs, A, b, acc_free = held_system(model, s, contacts)
+    lam = solve(A, [-bk for bk in b])
+    d = model.response(s, cs, lam)
+    return [a + da for a, da in zip(acc_free, d, strict=True)], lam
 
 
 def contact_system(model: BodyModel, y: np.ndarray, contacts: list[int]):
-    """(A, b, J, Minv, acc_free) for the contacts held, at state y."""
-    idx = np.asarray(contacts, dtype=int)
-    gap, normal, lever, vn, _ = model.contacts(y, idx)
-    J = model.jacobian(normal, lever)
+    """(A, b, J, Minv, acc_free) for the contacts held, at state y (arrays)."""
+    cs, A, b, acc_free = held_system(model, state(y), contacts)
     Minv = model.mass_matrix_inv(y[Q])
-    acc_free = model.free_acceleration(y)
-    A = J @ Minv @ J.T
-    b = J @ acc_free + model.bias(y, normal, lever, idx)
-    return A, b, J, Minv, acc_free
+    return (
+        np.array(A),
+        np.array(b),
+        model.jacobian([c.normal for c in cs], [c.lever for c in cs]),
+        Minv,
+        np.array(acc_free),
+    )
 
 
 def solve_contact_lcp(
@@ -45,10 +66,11 @@ def solve_contact_lcp(
     holding the contact, wins)."""
     if not candidates:
         return [], np.zeros(0)
-    A, b, *_ = contact_system(model, y, candidates)
+    _, A, b, _ = held_system(model, state(y), candidates)
     m = len(candidates)
     if m <= 2:
         return _lcp_small(candidates, A, b, tol)
+    A, b = np.array(A), np.array(b)
     best = None
     for size in range(m, -1, -1):
         for S in itertools.combinations(range(m), size):
@@ -75,11 +97,10 @@ def solve_contact_lcp(
     return active, np.array([lam[i] for i in S if lam[i] > 0.0])
 
 
-def _lcp_small(candidates: list[int], A: np.ndarray, b: np.ndarray, tol: float):
-    """solve_contact_lcp's enumeration written out for one or two candidates, in the
-    same order (both, then each alone, then none), with Cramer's rule for the 2 × 2."""
-    a = A.tolist()
-    bb = b.tolist()
+def _lcp_small(candidates: list[int], a: list, bb: list, tol: float):
+    """solve_contact_lcp's enumeration written out for one or two candidates (A = a and
+    b = bb as floats), in the same order (both, then each alone, then none), with
+    Cramer's rule for the 2 × 2."""
 
     def ok(lam: float) -> bool:
         return lam >= -tol * (1 + abs(lam))
@@ -95,12 +116,12 @@ def _lcp_small(candidates: list[int], A: np.ndarray, b: np.ndarray, tol: float):
         if bb[0] >= 0.0:
             return [], np.zeros(0)
         raise RuntimeError("contact complementarity problem has no solution")
-    det = a[0][0] * a[1][1] - a[0][1] * a[1][0]
-    if det != 0.0:
-        l0 = (-bb[0] * a[1][1] + bb[1] * a[0][1]) / det
-        l1 = (-bb[1] * a[0][0] + bb[0] * a[1][0]) / det
-        if ok(l0) and ok(l1):
-            return result([(candidates[0], l0), (candidates[1], l1)])
+    try:
+        both = solve(a, [-bb[0], -bb[1]])
+    except np.linalg.LinAlgError:  # det = 0: not with both held
+        both = None
+    if both is not None and ok(both[0]) and ok(both[1]):
+        return result(list(zip(candidates, both, strict=True)))
     for i, j in ((0, 1), (1, 0)):
         if a[i][i] == 0.0:
             continue
@@ -114,34 +135,27 @@ def _lcp_small(candidates: list[int], A: np.ndarray, b: np.ndarray, tol: float):
 
 def constrained_rhs(model: BodyModel, contacts: list[int]):
     """dy/dt with the contacts held as bilateral constraints (forces may go negative:
-    that is the lift-off signal)."""
+    that is the lift-off signal); q̇ = ½ [0, ω] ⊗ q.  On floats (`held_motion`)."""
+    held = list(contacts)
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-        A, b, J, Minv, acc_free = contact_system(model, y, contacts)
-        lam = np.linalg.solve(A, -b)
-        acc = acc_free + Minv @ J.T @ lam
-        dy = np.empty(13)
-        dy[X] = y[V]
-        w = y[W]
-        dy[Q] = 0.5 * qt.multiply([0.0, *w.tolist()], y[Q])
-        dy[V] = acc[:3]
-        dy[W] = acc[3:]
-        return dy
+        s = state(y)
+        acc, _ = held_motion(model, s, held)
+        w0, w1, w2 = s.w
+        dq = qt.product((0.0, w0, w1, w2), s.q)
+        return np.array([*s.v, *(0.5 * c for c in dq), *acc])
 
     return rhs
 
 
 def contact_forces(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
-    A, b, *_ = contact_system(model, y, contacts)
-    return np.linalg.solve(A, -b)
+    return np.array(held_motion(model, state(y), contacts)[1])
 
 
 def constrained_acceleration(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
     if not contacts:
         return model.free_acceleration(y)
-    A, b, J, Minv, acc_free = contact_system(model, y, contacts)
-    lam = np.linalg.solve(A, -b)
-    return acc_free + Minv @ J.T @ lam
+    return np.array(held_motion(model, state(y), contacts)[0])
 
 
 def project_positions(model: BodyModel, y: np.ndarray, contacts: list[int]) -> np.ndarray:
@@ -149,13 +163,11 @@ def project_positions(model: BodyModel, y: np.ndarray, contacts: list[int]) -> n
     mass metric) so the held contacts have gap 0.  Two Gauss–Newton passes."""
     out = np.array(y, dtype=float)
     for _ in range(2):
-        gap, normal, lever, _, _ = model.contacts(out, np.asarray(contacts, dtype=int))
-        J = model.jacobian(normal, lever)
-        Minv = model.mass_matrix_inv(out[Q])
-        A = J @ Minv @ J.T
-        d = Minv @ J.T @ np.linalg.solve(A, -gap)
+        s = state(out)
+        cs = model.contact_list(s, contacts)
+        d = model.response(s, cs, solve(model.delassus(s, cs), [-c.gap for c in cs]))
         out[X] += d[:3]
-        out[Q] = qt.normalize(qt.multiply(qt.from_rotation_vector(d[3:]), out[Q]))
+        out[Q] = qt.unit(qt.product(qt.exp_components(*d[3:]), s.q))
     return out
 
 

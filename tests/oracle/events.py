@@ -21,7 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .body import BodyModel, V, X
+from . import quaternion as qt
+from .body import EPS, BodyModel, V, X, row_dot, state
 from .flight import FlightConstants, flight_acceleration, free_flight
 
 
@@ -39,11 +40,12 @@ class GapJet:
 def gap_jet(model: BodyModel, y: np.ndarray, acc6: np.ndarray, idx=None) -> GapJet:
     """g, g′ = J u, g″ = J [v̇; ω̇] + bias for the contacts `idx` (every contact by
     default), at state y with accelerations acc6."""
-    gap, normal, lever, vn, noise = model.contacts(y, idx)
-    J = model.jacobian(normal, lever)
-    accel = J @ acc6 + model.bias(y, normal, lever, idx)
+    s = state(y)
+    c = model.contact_arrays(s, idx)
+    a = qt.components(acc6)
+    accel = row_dot(c, a[:3], a[3:]) + c.bias
     vscale = model.velocity_scale(y)
-    return GapJet(gap, vn, accel, noise, np.full_like(vn, 64 * np.finfo(float).eps * vscale))
+    return GapJet(c.gap, c.vn, accel, c.noise, np.full_like(c.vn, 64 * EPS * vscale))
 
 
 def first_root_lower_bound(g: float, g1: float, g2: float, K: float, B: float) -> float:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import quaternion as qt
-from .body import BodyModel, Q, W, cross
+from .body import BodyModel, Q, W, cross3
 
 
 @dataclass(frozen=True)
@@ -67,18 +67,18 @@ def free_flight(fc: FlightConstants, s: float) -> np.ndarray:
     x0, x1, x2, *q0, v0, v1, v2 = fc.y0[:10].tolist()
     g = fc.gravity
     L = fc.L_over_A.tolist()
-    q_prec = qt.from_rotation_vector([L[0] * s, L[1] * s, L[2] * s])
+    q_prec = qt.exp_components(L[0] * s, L[1] * s, L[2] * s)
     half = 0.5 * fc.lam * s
-    q_spin = [math.cos(half), 0.0, 0.0, math.sin(half)]
-    q = qt.normalize(qt.multiply(qt.multiply(q_prec, q0), q_spin))
-    e0, e1, e2 = qt.body_axis(q).tolist()
+    q_spin = (math.cos(half), 0.0, 0.0, math.sin(half))
+    q = qt.unit(qt.product(qt.product(q_prec, q0), q_spin))
+    e0, e1, e2 = qt.axis(q)
     lam = fc.lam
     return np.array(
         [
             x0 + v0 * s,
             x1 + v1 * s,
             x2 + v2 * s - 0.5 * g * s * s,
-            *q.tolist(),
+            *q,
             v0,
             v1,
             v2 - g * s,
@@ -91,6 +91,7 @@ def free_flight(fc: FlightConstants, s: float) -> np.ndarray:
 
 def flight_acceleration(fc: FlightConstants, y: np.ndarray) -> np.ndarray:
     """[v̇; ω̇] in flight: (0, 0, −g) and ω̇ = λ (L/A) × e3."""
-    e3 = qt.body_axis(y[Q])
-    wdot = fc.lam * cross(fc.L_over_A, e3)
-    return np.array([0.0, 0.0, -fc.gravity, *wdot])
+    e3 = qt.axis(qt.components(y[Q]))
+    lam = fc.lam
+    wdot = cross3(fc.L_over_A.tolist(), e3)
+    return np.array([0.0, 0.0, -fc.gravity, lam * wdot[0], lam * wdot[1], lam * wdot[2]])

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .body import BodyModel, Q, V, W
+from .body import BodyModel, V, W, row_dot, solve, state
 
 
 @dataclass(frozen=True)
@@ -37,23 +37,22 @@ def impact_impulse(
     `others_post` holds the post-impact normal velocities of the contacts in `watch`
     (all contacts when None; NaN for the unwatched), so a caller that needs only the
     resting ones does not pay for every vertex of a large polygon."""
-    idx = np.arange(model.n_contacts) if watch is None else np.array([k, *watch], dtype=int)
-    gap, normal, lever, vn, _ = model.contacts(y, idx)
-    J = model.jacobian(normal, lever)
-    Minv = model.mass_matrix_inv(y[Q])
-    row = k if watch is None else 0
-    jk = J[row]
-    w = float(jk @ Minv @ jk)
-    u_pre = float(vn[row])
+    idx = range(model.n_contacts) if watch is None else [k, *watch]
+    s = state(y)
+    cs = model.contact_list(s, idx)
+    ck = cs[k if watch is None else 0]
+    w = model.delassus(s, [ck])[0][0]  # J_k M⁻¹ J_kᵀ
+    u_pre = ck.vn
     zeta = -(1.0 + gamma) * u_pre / w
-    dq = Minv @ jk * zeta
+    dq = model.response(s, [ck], [zeta])
     y_post = np.array(y, dtype=float)
     y_post[V] += dq[:3]
     y_post[W] += dq[3:]
-    vn_idx = J @ np.concatenate([y_post[V], y_post[W]])
+    v, om = y_post[V].tolist(), y_post[W].tolist()
+    vn_idx = [row_dot(c, v, om) for c in cs]
     vn_post = np.full(model.n_contacts, np.nan)
-    vn_post[idx] = vn_idx
-    return ImpactResult(y_post, zeta, u_pre, float(vn_idx[row]), vn_post)
+    vn_post[list(idx)] = vn_idx
+    return ImpactResult(y_post, zeta, u_pre, vn_idx[k if watch is None else 0], vn_post)
 
 
 def apply_normal_impulses(
@@ -65,12 +64,11 @@ def apply_normal_impulses(
     momentum and vertical angular momentum are untouched on flat ground."""
     if not contacts:
         return y
-    gap, normal, lever, vn, _ = model.contacts(y, np.asarray(contacts, dtype=int))
-    J = model.jacobian(normal, lever)
-    Minv = model.mass_matrix_inv(y[Q])
-    A = J @ Minv @ J.T
-    mu = np.linalg.solve(A, np.asarray(target_vn) - vn)
-    dq = Minv @ J.T @ mu
+    s = state(y)
+    cs = model.contact_list(s, contacts)
+    target = np.asarray(target_vn, dtype=float).tolist()
+    mu = solve(model.delassus(s, cs), [t - c.vn for t, c in zip(target, cs, strict=True)])
+    dq = model.response(s, cs, mu)
     out = np.array(y, dtype=float)
     out[V] += dq[:3]
     out[W] += dq[3:]

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .body import BodyModel, Q
+from .body import BodyModel, Q, state
 
 
 @dataclass(frozen=True)
@@ -30,10 +30,15 @@ class LcpSolution:
 
 def delassus(model: BodyModel, y: np.ndarray, contacts: list[int]) -> tuple[np.ndarray, ...]:
     """(J, M⁻¹, W = J M⁻¹ Jᵀ, u⁻ = J(v, ω)) of the contacts at state y."""
-    _, normal, lever, vn, _ = model.contacts(y, np.asarray(contacts, dtype=int))
-    J = model.jacobian(normal, lever)
-    Minv = model.mass_matrix_inv(y[Q])
-    return J, Minv, J @ Minv @ J.T, np.asarray(vn, dtype=float)
+    s = state(y)
+    cs = model.contact_list(s, contacts)
+    W = np.array(model.delassus(s, cs)).reshape(len(cs), len(cs))
+    return (
+        model.jacobian([c.normal for c in cs], [c.lever for c in cs]),
+        model.mass_matrix_inv(y[Q]),
+        W,
+        np.array([c.vn for c in cs]),
+    )
 
 
 def moreau_lcp(W: np.ndarray, u_pre: np.ndarray, gamma: float, tol: float = 1e-9) -> LcpSolution:

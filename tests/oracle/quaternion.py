@@ -4,8 +4,9 @@ Small rotations are formed from sin(θ/2)/θ with a series near 0, so that rotat
 vectors of 1e-12 keep all their digits (no 1 - cos differences).
 
 The formulas work on the components as Python floats (`components`): numpy's scalars
-and its calls on 4-element arrays cost far more than the arithmetic, and the same
-operations in the same order give the same doubles.
+and its calls on 4-element arrays cost far more than the arithmetic.  Each formula is
+written once, on floats (`product`, `exp_components`, `rotation_rows`, `axis`,
+`unit`); the functions that take and return arrays wrap it.
 """
 
 from __future__ import annotations
@@ -20,18 +21,21 @@ def components(q) -> list[float]:
     return q.tolist() if isinstance(q, np.ndarray) else [float(c) for c in q]
 
 
+def product(a, b) -> tuple[float, float, float, float]:
+    """Hamilton product a ⊗ b of two quaternions given as sequences of floats."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+
+
 def multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton product a ⊗ b."""
-    aw, ax, ay, az = components(a)
-    bw, bx, by, bz = components(b)
-    return np.array(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ]
-    )
+    return np.array(product(components(a), components(b)))
 
 
 def half_sinc(theta: float) -> float:
@@ -42,13 +46,16 @@ def half_sinc(theta: float) -> float:
     return math.sin(0.5 * theta) / theta
 
 
+def exp_components(p0: float, p1: float, p2: float) -> tuple[float, float, float, float]:
+    """exp of the rotation vector φ = (p0, p1, p2) (floats): angle |φ| about φ/|φ|."""
+    theta = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+    s = half_sinc(theta)
+    return (math.cos(0.5 * theta), s * p0, s * p1, s * p2)
+
+
 def from_rotation_vector(phi) -> np.ndarray:
     """exp of the rotation vector φ: angle |φ| about φ/|φ|."""
-    phi = np.asarray(phi, dtype=float)
-    theta = math.sqrt(float(phi @ phi))
-    s = half_sinc(theta)
-    p0, p1, p2 = phi.tolist()
-    return np.array([math.cos(0.5 * theta), s * p0, s * p1, s * p2])
+    return np.array(exp_components(*components(phi)))
 
 
 def to_rotation_vector(q: np.ndarray) -> np.ndarray:
@@ -63,25 +70,41 @@ def to_rotation_vector(q: np.ndarray) -> np.ndarray:
     return v * (angle / s)
 
 
-def to_matrix(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = components(q)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
+def rotation_rows(q) -> tuple[tuple[float, float, float], ...]:
+    """The rows of the rotation matrix R of q (floats w, x, y, z)."""
+    w, x, y, z = q
+    return (
+        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
     )
+
+
+def to_matrix(q: np.ndarray) -> np.ndarray:
+    return np.array(rotation_rows(components(q)))
+
+
+def axis(q) -> tuple[float, float, float]:
+    """The body's symmetry axis e3 = R ẑ in world coordinates, of q (floats w, x, y, z),
+    small x, y kept exact."""
+    w, x, y, z = q
+    return (2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y))
 
 
 def body_axis(q: np.ndarray) -> np.ndarray:
     """World coordinates of the body's symmetry axis e3 = R ẑ (small x, y kept exact)."""
-    w, x, y, z = components(q)
-    return np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+    return np.array(axis(components(q)))
+
+
+def unit(q) -> tuple[float, ...]:
+    """q / |q| of a quaternion given as floats."""
+    w, x, y, z = q
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    return (w / n, x / n, y / n, z / n)
 
 
 def normalize(q: np.ndarray) -> np.ndarray:
-    return q / math.sqrt(float(q @ q))
+    return np.array(unit(components(q)))
 
 
 def angle_between(q1: np.ndarray, q2: np.ndarray) -> float:
