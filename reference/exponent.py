@@ -137,16 +137,17 @@ def _inverse_exponent(target: float, dL1: float, dL2: float) -> float | None:
 
 
 def ordinary_least_squares(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float, float]:
-    """Line y = b + c x: (c, b, standard error of c, rms residual)."""
-    xm, ym = x.mean(), y.mean()
-    sxx = float(np.sum((x - xm) ** 2))
-    c = float(np.sum((x - xm) * (y - ym)) / sxx)
-    b = float(ym - c * xm)
-    r = y - (b + c * x)
+    """Line y = b + c x: (c, b, standard error of c, rms residual), with
+    c = Σ(x − x̄)(y − ȳ)/Σ(x − x̄)², b = ȳ − c x̄ and residuals r = y − (b + c x)."""
     n = len(x)
-    rms = float(math.sqrt(np.sum(r * r) / n))
-    se = float(math.sqrt(np.sum(r * r) / max(n - 2, 1) / sxx))
-    return c, b, se, rms
+    xm, ym = float(x.sum()) / n, float(y.sum()) / n
+    dx = x - xm
+    sxx = float(dx @ dx)
+    c = float(dx @ (y - ym)) / sxx
+    b = ym - c * xm
+    r = y - (b + c * x)
+    rr = float(r @ r)
+    return c, b, math.sqrt(rr / max(n - 2, 1) / sxx), math.sqrt(rr / n)
 
 
 def fit_log_energy_exponent(log_ttg, log_energy) -> dict:
@@ -157,17 +158,18 @@ def fit_log_energy_exponent(log_ttg, log_energy) -> dict:
     ok = np.isfinite(x) & np.isfinite(y)
     x, y = x[ok], y[ok]
     n = len(x)
+    x_span = float(x.max() - x.min()) if n else 0.0
     out = {
         "c": None,
         "c_stderr": None,
         "log_a": None,
         "n_points": n,
         "rms_residual": None,
-        "log10_energy_span": float(np.ptp(y) / LN10) if n else 0.0,
-        "log10_time_span": float(np.ptp(x) / LN10) if n else 0.0,
+        "log10_energy_span": float(y.max() - y.min()) / LN10 if n else 0.0,
+        "log10_time_span": x_span / LN10,
         "c_spread": None,
     }
-    if n < 3 or np.ptp(x) == 0:
+    if n < 3 or x_span == 0:
         return out
     c, log_a, se, rms = ordinary_least_squares(x, y)
     out.update(c=c, c_stderr=se, log_a=log_a, rms_residual=rms)

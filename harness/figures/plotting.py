@@ -41,19 +41,36 @@ def save(fig, path: Path, dpi: int = 120) -> Path:
     return path
 
 
-def solutions(n: int, rho: float, gamma: float):
-    return selfsimilar_solutions(LinearModel.polygon(n, rho, gamma))
+def solutions(n: int, rho: float, gamma: float, stability: bool = True):
+    """The self-similar motions of the n-gon (reference.linear.selfsimilar); `stability`:
+    with the eigenvalues of each one's reduced map (the figures that read only existence
+    and feasibility go without)."""
+    return selfsimilar_solutions(LinearModel.polygon(n, rho, gamma), with_stability=stability)
+
+
+# The β scatter's marker of each kind of solution: format and style (scatter_betas).
+MARKERS = {
+    "trivial": ("*", {"color": "tab:orange", "ms": 5}),
+    "feasible": ("o", {"color": "tab:blue", "ms": 3}),
+    "infeasible": ("o", {"mfc": "none", "color": "tab:gray", "ms": 3}),
+}
+
+
+def _kind(s) -> str:
+    return "trivial" if s.trivial else "feasible" if s.feasible else "infeasible"
 
 
 def scatter_betas(ax, xs, sols_list, xlabel):
+    """Each solution's β over its x, one line of markers per kind (MARKERS)."""
+    points = {kind: ([], []) for kind in MARKERS}
     for x, sols in zip(xs, sols_list, strict=True):
         for s in sols:
-            if s.trivial:
-                ax.plot(x, s.beta, "*", color="tab:orange", ms=5)
-            elif s.feasible:
-                ax.plot(x, s.beta, "o", color="tab:blue", ms=3)
-            else:
-                ax.plot(x, s.beta, "o", mfc="none", color="tab:gray", ms=3)
+            px, py = points[_kind(s)]
+            px.append(x)
+            py.append(s.beta)
+    for kind, (fmt, style) in MARKERS.items():
+        if points[kind][0]:
+            ax.plot(*points[kind], fmt, **style)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(BETA)
     ax.set_ylim(0, 1.02)

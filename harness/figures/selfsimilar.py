@@ -26,7 +26,7 @@ def fig_beta_vs_rho(out: Path, progress) -> dict:
     facts = {}
     for ax, n in zip(axes, (3, 25), strict=True):
         progress(f"  beta_vs_rho n={n}")
-        sols = [solutions(n, float(r), 0.0) for r in rhos]
+        sols = [solutions(n, float(r), 0.0, stability=False) for r in rhos]
         scatter_betas(ax, rhos, sols, RHO)
         ax.set_title(f"n = {n}, γ = 0")
         legend(ax)
@@ -70,6 +70,15 @@ def fig_beta_vs_rho(out: Path, progress) -> dict:
     }
 
 
+def _smallest_feasible_rho(n: int, rhos) -> float:
+    """The first ρ of `rhos` at which the n-gon (γ = 0) has a feasible self-similar
+    motion (nan if none): the ρ after it are not needed."""
+    for r in rhos:
+        if any(s.feasible for s in solutions(n, float(r), 0.0, stability=False)):
+            return float(r)
+    return math.nan
+
+
 def fig_feasibility_border(out: Path, progress) -> dict:
     plt = pyplot()
     ns = [3, 4, 5, 6, 7, 8, 10, 12, 15, 20, 25, 30, 40, 50]
@@ -77,8 +86,7 @@ def fig_feasibility_border(out: Path, progress) -> dict:
     border = []
     for n in ns:
         progress(f"  feasibility_border n={n}")
-        feas = [any(s.feasible for s in solutions(n, float(r), 0.0)) for r in rhos]
-        border.append(float(rhos[np.argmax(feas)]) if any(feas) else math.nan)
+        border.append(_smallest_feasible_rho(n, rhos))
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(ns, border, "o-")
     ax.axhline(0.5, color="k", lw=0.8, ls=":", label="homogeneous disk ρ ≈ 1/2")
@@ -106,7 +114,7 @@ def fig_beta_vs_gamma(out: Path, progress) -> dict:
     multi = []
     for ax, (n, rho) in zip(axes.flat, [(3, 0.25), (3, 0.5), (25, 0.25), (25, 0.5)], strict=True):
         progress(f"  beta_vs_gamma n={n} rho={rho}")
-        sols = [solutions(n, rho, float(g)) for g in gammas]
+        sols = [solutions(n, rho, float(g), stability=False) for g in gammas]
         scatter_betas(ax, gammas, sols, GAMMA)
         ax.set_title(f"n = {n}, ρ = {rho}")
         multi += [(n, rho, float(g)) for g, ss in zip(gammas, sols, strict=True) if len(ss) > 1]

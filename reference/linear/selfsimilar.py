@@ -39,9 +39,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numpy.polynomial import Polynomial as P
+from numpy.polynomial.polynomial import polyroots
 
 from ..core.tolerances import TINY
 from ._text import SELFSIMILAR_LEGEND, table
@@ -49,6 +51,7 @@ from .kernel import first_hit
 from .model import LinearModel
 
 FEAS_TOL = 1e-12
+_DQ_DX = np.hstack([np.zeros((3, 3)), np.eye(3)])  # d q / d(p, q)
 
 
 # --------------------------------------------------------------------------- algebra
@@ -59,68 +62,152 @@ def smooth_acceleration(model: LinearModel) -> np.ndarray:
     return model.a_contact(0) if model.restitution == 0.0 else model.a_free
 
 
-def _adjugate_coefficients(M: np.ndarray):
-    """adj(xI − M) = B2 x² + B1 x + B0 and det(xI − M) = x³ + d2 x² + d1 x + d0
-    (Faddeev-LeVerrier): B2 = I, B1 = M − tr(M) I, B0 = M² − tr(M) M + c I with
-    c = (tr(M)² − tr(M²))/2, and det = x³ − tr(M) x² + c x − det(M)."""
-    I = np.eye(3)
-    t = float(np.trace(M))
-    c = 0.5 * (t * t - float(np.trace(M @ M)))
-    B = [M @ M - t * M + c * I, M - t * I, I]
-    d = [-float(np.linalg.det(M)), c, -t, 1.0]
-    return B, d
+_Vec = tuple[float, float, float]
+_Rows = tuple[_Vec, _Vec, _Vec]  # a 3×3 matrix by rows
+
+
+class _Floats(NamedTuple):
+    """M, R⁻¹, R and U0 (by rows) and R⁻¹a, a and f0 of a model as tuples of floats, for
+    the 3×3 algebra of `_state` and `_polynomial` (numpy's overhead per call is many
+    times a 3×3 solve)."""
+
+    M: _Rows
+    Ri: _Rows
+    R: _Rows
+    U0: _Rows
+    Ria: _Vec
+    a: _Vec
+    f0: _Vec
+
+
+@dataclass(frozen=True)
+class _Parts:
+    """What every step of one model's analysis uses, formed once per model and shared by
+    its β candidates (`_parts`)."""
+
+    U0: np.ndarray
+    Ri: np.ndarray  # R⁻¹ = Rᵀ
+    M: np.ndarray  # R⁻¹U0
+    a: np.ndarray  # `smooth_acceleration`
+    F: np.ndarray  # the contact rows f_k
+    absF: np.ndarray  # |F|, elementwise (the feasibility tolerance's scale)
+    Fa: np.ndarray  # F a: each contact's acceleration in the smooth phase
+    f1U0: np.ndarray  # f1ᵀU0 (the Jacobian's dτ)
+    dpa_dx: np.ndarray  # d p_a / d(p, q) = [U0 0] (the Jacobian's)
+    held: bool  # γ = 0: vertex 0 is held in the smooth phase
+    floats: _Floats
+
+
+def _parts(model: LinearModel) -> _Parts:
+    """The `_Parts` of a model."""
+    U0, R, F = model.U(0), model.R, model.F
+    Ri, a = R.T, smooth_acceleration(model)
+    M = Ri @ U0
+    floats = _Floats(
+        *(tuple(map(tuple, x.tolist())) for x in (M, Ri, R, U0)),
+        *(tuple(x.tolist()) for x in (Ri @ a, a, F[0])),
+    )
+    dpa_dx = np.hstack([U0, np.zeros((3, 3))])
+    held = model.restitution == 0.0
+    return _Parts(U0, Ri, M, a, F, np.abs(F), F @ a, F[1] @ U0, dpa_dx, held, floats)
+
+
+def _cross(u, v) -> _Vec:
+    """u × v of two 3-vectors of floats."""
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+def _dot(u, v) -> float:
+    """u · v of two 3-vectors of floats."""
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+def _shifted_adjugate(s: float, A: _Rows) -> tuple[_Rows, float]:
+    """(columns of adj(B), det B) for B = sI − A, A a 3×3 matrix as rows of floats: with
+    b0, b1, b2 the rows of B, adj(B) has the columns b1×b2, b2×b0, b0×b1 and det B =
+    b0·(b1×b2)."""
+    (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = A
+    b0, b1, b2 = (s - a00, -a01, -a02), (-a10, s - a11, -a12), (-a20, -a21, s - a22)
+    c0 = _cross(b1, b2)
+    return (c0, _cross(b2, b0), _cross(b0, b1)), _dot(b0, c0)
+
+
+def _shifted_solve(s: float, A: _Rows, r) -> list[float]:
+    """x = (sI − A)⁻¹ r = adj(sI − A) r / det(sI − A) (Cramer's rule, `_shifted_adjugate`)."""
+    (c0, c1, c2), det = _shifted_adjugate(s, A)
+    r0, r1, r2 = r
+    return [(r0 * x + r1 * y + r2 * z) / det for x, y, z in zip(c0, c1, c2, strict=True)]
+
+
+def _adjugate_coefficients(A: _Rows, r) -> tuple[list[list[float]], list[float]]:
+    """adj(xI − A) r = Σ_k x^k B_k r and det(xI − A) = x³ + d2 x² + d1 x + d0 for a 3×3 A
+    (rows of floats), with the Faddeev-LeVerrier coefficients B2 = I, B1 = A − tr(A) I,
+    B0 = A² − tr(A) A + c I, c = (tr(A)² − tr(A²))/2, and det = x³ − tr(A) x² + c x +
+    det(0I − A).  Returns [B0 r, B1 r, B2 r] and [d0, d1, d2, 1]."""
+    t = A[0][0] + A[1][1] + A[2][2]
+    c = 0.5 * (t * t - sum(A[i][j] * A[j][i] for i in range(3) for j in range(3)))
+    Ar = [_dot(row, r) for row in A]
+    AAr = [_dot(row, Ar) for row in A]
+    B0r = [z - t * y + c * x for x, y, z in zip(r, Ar, AAr, strict=True)]
+    B1r = [y - t * x for x, y in zip(r, Ar, strict=True)]
+    return [B0r, B1r, list(r)], [_shifted_adjugate(0.0, A)[1], c, -t, 1.0]
 
 
 def selfsimilar_polynomial(model: LinearModel) -> P:
     """N(β) of the module docstring, divided by its factors β (its real roots other than
-    eigenvalues of M are the nontrivial self-similar β).  Coefficients from the
+    eigenvalues of M are the nontrivial self-similar β): `_polynomial` of the model."""
+    return P(_polynomial(_parts(model)))
+
+
+def _polynomial(parts: _Parts) -> np.ndarray:
+    """The coefficients of N(β) (`selfsimilar_polynomial`), lowest degree first, from the
     adjugates' Faddeev-LeVerrier expansions, in x = β for βI − M and x = β² for
-    β²I − R⁻¹."""
-    U0, R = model.U(0), model.R
-    Ri = R.T
-    a = smooth_acceleration(model)
-    B1, d1 = _adjugate_coefficients(Ri @ U0)
-    B2, _ = _adjugate_coefficients(Ri)
-    Ria = Ri @ a
-    # inner(β) = U0 adj1(β) R⁻¹a + det1(β) a/2 = Σ_k v_k β^k, k = 0..3
-    v = [U0 @ (B1[k] @ Ria) if k < 3 else np.zeros(3) for k in range(4)]
-    for k in range(4):
-        v[k] = v[k] + 0.5 * d1[k] * a
-    f0 = model.F[0]
-    coef = np.zeros(8)
-    for j in range(3):  # adj2 = Σ_j C_j β^(2j)
-        row = f0 @ B2[j] @ Ri
-        for k in range(4):
-            coef[2 * j + k] += float(row @ v[k])
-    big = float(np.max(np.abs(coef)))
+    β²I − R⁻¹: N = Σ_jk β^(2j+k) w_jᵀ v_k with w_jᵀ = f0ᵀ C_j R⁻¹ (adj(β²I − R⁻¹) =
+    Σ_j C_j β^(2j); w_j = R C_jᵀ f0, C_jᵀ those of adj(xI − R), R = (R⁻¹)ᵀ) and
+    U0 adj(βI − M) R⁻¹a + det(βI − M) a/2 = Σ_k v_k β^k (B_3 = 0, d_3 = 1)."""
+    x = parts.floats
+    BRia, d = _adjugate_coefficients(x.M, x.Ria)
+    Cf0, _ = _adjugate_coefficients(x.R, x.f0)
+    v = [
+        [_dot(row, b) + 0.5 * dk * ak for row, ak in zip(x.U0, x.a, strict=True)]
+        for b, dk in zip([*BRia, (0.0, 0.0, 0.0)], d, strict=True)
+    ]
+    w = [[_dot(row, c) for row in x.R] for c in Cf0]
+    coef = [0.0] * 8
+    for j, wj in enumerate(w):
+        for k, vk in enumerate(v):
+            coef[2 * j + k] += _dot(wj, vk)
+    big = max(map(abs, coef))
     while len(coef) > 1 and abs(coef[0]) <= 1e-12 * big:
         coef = coef[1:]
     while len(coef) > 1 and abs(coef[-1]) <= 1e-12 * big:
         coef = coef[:-1]
-    return P(coef)
+    return np.array(coef)
 
 
 def selfsimilar_state(model: LinearModel, beta: float, tau0: float = 1.0):
     """(q0, p0) solving the self-similarity equations for a given β (not an eigenvalue
-    of R⁻¹U0) and τ0: p0 = τ0 (βI − M)⁻¹R⁻¹a, q0 = (β²I − R⁻¹)⁻¹R⁻¹(U0p0τ0 + aτ0²/2)."""
-    U0, Ri = model.U(0), model.R.T
-    a = smooth_acceleration(model)
-    p0 = np.linalg.solve(beta * np.eye(3) - Ri @ U0, Ri @ a) * tau0
-    q0 = np.linalg.solve(beta * beta * np.eye(3) - Ri, Ri @ (U0 @ p0 * tau0 + 0.5 * a * tau0**2))
+    of R⁻¹U0) and τ0 (`_state`), as arrays."""
+    q0, p0 = _state(_parts(model), beta, tau0)
+    return np.array(q0), np.array(p0)
+
+
+def _state(parts: _Parts, beta: float, tau0: float = 1.0):
+    """(q0, p0) of the module docstring as lists of floats: p0 = τ0 (βI − M)⁻¹R⁻¹a,
+    q0 = (β²I − R⁻¹)⁻¹R⁻¹(U0p0τ0 + aτ0²/2), each solve in closed form (`_shifted_solve`)."""
+    x = parts.floats
+    p0 = [pk * tau0 for pk in _shifted_solve(beta, x.M, x.Ria)]
+    u = [_dot(row, p0) * tau0 + 0.5 * ak * tau0**2 for row, ak in zip(x.U0, x.a, strict=True)]
+    q0 = _shifted_solve(beta * beta, x.Ri, [_dot(row, u) for row in x.Ri])
     return q0, p0
 
 
-def _polish(model: LinearModel, beta: float) -> float:
-    """Secant steps on the gap condition f0ᵀq0(β) itself (solves with the model's
-    matrices: better conditioned than the expanded polynomial near β → 1)."""
-    U0, Ri, f0 = model.U(0), model.R.T, model.F[0]
-    a = smooth_acceleration(model)
-    M, I = Ri @ U0, np.eye(3)
+def _polish(parts: _Parts, beta: float) -> float:
+    """Secant steps on the gap condition f0ᵀq0(β) itself (`_state`: solves with the
+    model's matrices, better conditioned than the expanded polynomial near β → 1)."""
 
     def gap(b: float) -> float:
-        p0 = np.linalg.solve(b * I - M, Ri @ a)
-        q0 = np.linalg.solve(b * b * I - Ri, Ri @ (U0 @ p0 + 0.5 * a))
-        return float(f0 @ q0)
+        return _dot(parts.floats.f0, _state(parts, b)[0])
 
     b0, b1 = beta, beta * (1 + 1e-8)
     g0, g1 = gap(b0), gap(b1)
@@ -146,49 +233,47 @@ def _first_root(g: float, v: float, a: float) -> float:
     return first_hit(g, v, a)
 
 
-def _impact_then_flight(model: LinearModel, p: np.ndarray, q: np.ndarray):
+def _impact_then_flight(parts: _Parts, p: np.ndarray, q: np.ndarray):
     """The steps shared by C̄ and its Jacobian: impact p_a = U0 p, then smooth motion
     with acceleration a until contact 1 reaches the ground at τ (f1·q_b = 0).
-    Returns (U0, R⁻¹, f1, a, p_a, τ, p_b, q_b)."""
-    U0, Ri, f1 = model.U(0), model.R.T, model.F[1]
-    a = smooth_acceleration(model)
-    pa = U0 @ p
+    Returns (τ, p_b, q_b)."""
+    a, f1 = parts.a, parts.F[1]
+    pa = parts.U0 @ p
     tau = _first_root(float(f1 @ q), float(f1 @ pa), float(f1 @ a))
     pb = pa + a * tau
     qb = q + pa * tau + 0.5 * a * tau * tau
-    return U0, Ri, f1, a, pa, tau, pb, qb
+    return tau, pb, qb
 
 
 def reduced_map(model: LinearModel, p: np.ndarray, q: np.ndarray):
     """C̄(p, q) = T1(C0(p, q)) (eq. barC, appendix B); returns (p̄', q̄', τ)."""
-    _, Ri, _, _, _, tau, pb, qb = _impact_then_flight(model, p, q)
+    parts = _parts(model)
+    tau, pb, qb = _impact_then_flight(parts, p, q)
     nb = float(np.linalg.norm(pb))
-    return Ri @ pb / nb, Ri @ qb / (nb * nb), tau
+    return parts.Ri @ pb / nb, parts.Ri @ qb / (nb * nb), tau
 
 
 def reduced_map_jacobian(model: LinearModel, p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Closed-form 6×6 Jacobian of C̄ with respect to (p, q) (module docstring):
+    """Closed-form 6×6 Jacobian of C̄ with respect to (p, q) (`_jacobian`)."""
+    return _jacobian(_parts(model), p, q)
+
+
+def _jacobian(parts: _Parts, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Closed-form 6×6 Jacobian of C̄ with respect to x = (p, q) (module docstring):
     dτ = −(f1ᵀdq + τ f1ᵀU0 dp) / f1ᵀp_b, dp_b = U0 dp + a dτ, dq_b = dq + τ U0 dp + p_b dτ,
-    d(p_b/|p_b|) = (dp_b − p̂ p̂ᵀdp_b)/|p_b|, d(q_b/|p_b|²) = dq_b/|p_b|² − 2 q_b p_bᵀdp_b/|p_b|⁴."""
-    U0, Ri, f1, a, pa, tau, pb, qb = _impact_then_flight(model, p, q)
-    D = float(f1 @ pb)
-    # dτ = g_p·dp + g_q·dq
-    g_p = -tau * (f1 @ U0) / D
-    g_q = -f1 / D
-    dpb_dp = U0 + np.outer(a, g_p)
-    dpb_dq = np.outer(a, g_q)
-    dqb_dp = tau * U0 + np.outer(pb, g_p)
-    dqb_dq = np.eye(3) + np.outer(pb, g_q)
-    nb = float(np.linalg.norm(pb))
-    ph = pb / nb
-    Pn = (np.eye(3) - np.outer(ph, ph)) / nb
-    J = np.zeros((6, 6))
-    J[:3, :3] = Ri @ Pn @ dpb_dp
-    J[:3, 3:] = Ri @ Pn @ dpb_dq
-    corr = -2.0 * np.outer(qb, pb) / nb**4
-    J[3:, :3] = Ri @ (dqb_dp / nb**2 + corr @ dpb_dp)
-    J[3:, 3:] = Ri @ (dqb_dq / nb**2 + corr @ dpb_dq)
-    return J
+    d(p_b/|p_b|) = (dp_b − p̂ p̂ᵀdp_b)/|p_b|, d(q_b/|p_b|²) = dq_b/|p_b|² − 2 q_b p_bᵀdp_b/|p_b|⁴;
+    each d/dx a 3×6 matrix."""
+    tau, pb, qb = _impact_then_flight(parts, p, q)
+    f1 = parts.F[1]
+    dtau = np.concatenate([tau * parts.f1U0, f1]) / -float(f1 @ pb)
+    dpb = parts.dpa_dx + parts.a[:, None] * dtau
+    dqb = tau * parts.dpa_dx + _DQ_DX + pb[:, None] * dtau
+    nb2 = float(pb @ pb)
+    nb = math.sqrt(nb2)
+    pb_dpb = pb @ dpb  # p_bᵀdp_b
+    top = (dpb - pb[:, None] * (pb_dpb / nb2)) / nb
+    bottom = dqb / nb2 - qb[:, None] * ((2.0 / nb2**2) * pb_dpb)
+    return np.concatenate([parts.Ri @ top, parts.Ri @ bottom])
 
 
 def finite_difference_jacobian(model: LinearModel, p, q, h: float = 1e-6) -> np.ndarray:
@@ -244,127 +329,120 @@ class SelfSimilar:
         }
 
 
-def _min_on_interval(c0: float, c1: float, c2: float, T: float) -> float:
-    """min of c0 + c1 s + c2 s²/2 over s ∈ [0, T]."""
-    vals = [c0, c0 + c1 * T + 0.5 * c2 * T * T]
-    if c2 > 0:
-        s = -c1 / c2
-        if 0 < s < T:
-            vals.append(c0 + c1 * s + 0.5 * c2 * s * s)
-    return min(vals)
+def _min_on_interval(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, T: float) -> np.ndarray:
+    """min of c0 + c1 s + c2 s²/2 over s ∈ [0, T], elementwise: the smallest of the values
+    at the ends and, where c2 > 0 and it lies inside, at the vertex s = −c1/c2."""
+    up = c2 > 0
+    s = -c1 / np.where(up, c2, 1.0)
+    inside = up & (0 < s) & (s < T)
+    vertex = np.where(inside, c0 + c1 * s + 0.5 * c2 * s * s, np.inf)
+    return np.minimum(np.minimum(c0, c0 + c1 * T + 0.5 * c2 * T * T), vertex)
 
 
 def feasibility_checks(model: LinearModel, q0, p0, tau0: float, beta: float) -> dict:
-    """The conditions of section 3.2 (module docstring), each a bool."""
-    F, U0 = model.F, model.U(0)
-    a = smooth_acceleration(model)
-    pa = U0 @ p0
-    n = model.n_contacts
-    scale_q = float(np.max(np.abs(F) @ (np.abs(q0) + np.abs(pa) * tau0 + np.abs(a) * tau0**2)))
+    """The conditions of section 3.2 (module docstring), each a bool (`_feasibility`)."""
+    return _feasibility(_parts(model), np.asarray(q0), np.asarray(p0), tau0, beta)
+
+
+def _feasibility(parts: _Parts, q0: np.ndarray, p0: np.ndarray, tau0: float, beta: float):
+    """The conditions of section 3.2 (module docstring), each a bool, from every contact's
+    gap g, velocity v and acceleration c after the impact (g + v s + c s²/2)."""
+    F, absF = parts.F, parts.absF
+    pa = parts.U0 @ p0
+    g, v, c = F @ q0, F @ pa, parts.Fa
+    abs_pa = np.abs(pa)
+    scale_q = float((absF @ (np.abs(q0) + abs_pa * tau0 + np.abs(parts.a) * tau0**2)).max())
     tol = FEAS_TOL * max(scale_q, TINY)
-    ok_pen = True
-    for k in range(n):
-        if k == 0 and model.restitution == 0.0:
-            continue
-        g0, v0, a0 = float(F[k] @ q0), float(F[k] @ pa), float(F[k] @ a)
-        if k == 1:
-            # above the ground strictly before τ0: its first root is τ0
-            t1 = first_hit(max(g0, 0.0), v0, a0)
-            if not (t1 >= tau0 * (1 - 1e-9)):
-                ok_pen = False
-            continue
-        if k == 0:
-            # γ > 0: vertex 0 must not come back before τ0
-            t0 = first_hit(0.0, v0, a0)
-            if not (t0 > tau0 * (1 + 1e-9)):
-                ok_pen = False
-            continue
-        if _min_on_interval(g0, v0, a0, tau0) < -tol:
-            ok_pen = False
     checks = {
         "approaching": bool(F[0] @ p0 < 0),
         "tau_positive": bool(tau0 > 0),
-        "non_penetration": ok_pen,
+        "non_penetration": _non_penetration(parts.held, g, v, c, tau0, tol),
         "beta_in_0_1": bool(0 < beta < 1),
     }
-    if model.restitution == 0.0:
-        vprev = float(F[n - 1] @ pa)
-        checks["held_vertex_released"] = bool(
-            vprev >= -FEAS_TOL * float(np.abs(F[n - 1]) @ np.abs(pa))
-        )
+    if parts.held:
+        checks["held_vertex_released"] = bool(v[-1] >= -FEAS_TOL * float(absF[-1] @ abs_pa))
     return checks
 
 
-def _trivial_solution(model: LinearModel, beta: float, vec: np.ndarray) -> SelfSimilar:
+def _non_penetration(held: bool, g, v, c, tau0: float, tol: float) -> bool:
+    """Condition (3): vertex 1 above the ground strictly before τ0 (its first root is τ0),
+    vertex 0 (γ > 0, not held) not back on it before τ0, and no other vertex's gap below
+    −tol on [0, τ0]."""
+    if not first_hit(max(float(g[1]), 0.0), float(v[1]), float(c[1])) >= tau0 * (1 - 1e-9):
+        return False
+    if not held and not first_hit(0.0, float(v[0]), float(c[0])) > tau0 * (1 + 1e-9):
+        return False
+    return not bool((_min_on_interval(g[2:], v[2:], c[2:], tau0) < -tol).any())
+
+
+def _trivial_solution(parts: _Parts, beta: float, vec: np.ndarray) -> SelfSimilar:
     """The trivial solution (τ0 = 0, q0 = 0) of a real eigenvalue β of R⁻¹U0 with
     eigenvector `vec`: p0 normalised with vertex 0 approaching; marginally feasible when
     the impact drives no other contact into the ground (all are at it, q0 = 0)."""
+    F = parts.F
     p0 = np.real(vec)
     p0 = p0 / np.linalg.norm(p0)
-    if model.F[0] @ p0 > 0:
+    if F[0] @ p0 > 0:
         p0 = -p0
-    q0 = np.zeros(3)
-    pa = model.U(0) @ p0
-    marginal = bool(
-        model.F[0] @ p0 < 0 and all(model.F[k] @ pa >= -1e-12 for k in range(2, model.n_contacts))
-    )
+    approaching = bool(F[0] @ p0 < 0)
+    marginal = approaching and bool((F[2:] @ (parts.U0 @ p0) >= -1e-12).all())
     checks = {
-        "approaching": bool(model.F[0] @ p0 < 0),
+        "approaching": approaching,
         "tau_positive": False,
         "non_penetration": marginal,
         "beta_in_0_1": True,
     }
-    return SelfSimilar(float(beta), True, 0.0, q0, p0, checks, False, marginal)
+    return SelfSimilar(float(beta), True, 0.0, np.zeros(3), p0, checks, False, marginal)
 
 
-def _trivial_solutions(model: LinearModel) -> tuple[list[SelfSimilar], list[float]]:
+def _trivial_solutions(parts: _Parts) -> tuple[list[SelfSimilar], list[float]]:
     """The trivial solutions, one per real eigenvalue β of M = R⁻¹U0 in (0, 1) (module
     docstring), and every real eigenvalue of M (which the nontrivial β must avoid)."""
-    lam, vec = np.linalg.eig(model.R.T @ model.U(0))
+    lam, vec = np.linalg.eig(parts.M)
     sols: list[SelfSimilar] = []
     real_eigs = []
-    for i, z in enumerate(lam):
+    for i, z in enumerate(lam.tolist()):
         if abs(z.imag) <= 1e-12 * max(1.0, abs(z)):
             real_eigs.append(z.real)
             if 1e-9 < z.real < 1:
-                sols.append(_trivial_solution(model, z.real, vec[:, i]))
+                sols.append(_trivial_solution(parts, z.real, vec[:, i]))
     return sols, real_eigs
 
 
-def _nontrivial_betas(model: LinearModel, real_eigs: list[float]) -> list[float]:
+def _nontrivial_betas(parts: _Parts, real_eigs: list[float]) -> list[float]:
     """The real roots of N in (0, 1) (the paper's polynomial π, section 3.1), polished
     on the gap condition, without duplicates and without eigenvalues of R⁻¹U0."""
-    N = selfsimilar_polynomial(model)
-    roots = N.roots() if N.degree() > 0 else np.zeros(0)
+    coef = _polynomial(parts)
+    roots = polyroots(coef) if len(coef) > 1 else np.zeros(0)
 
     def is_eigenvalue(b: float) -> bool:
         return any(abs(b - e) < 1e-9 for e in real_eigs)
 
     betas: list[float] = []
-    for r in roots:
+    for r in roots.tolist():
         if abs(r.imag) > 1e-6 * max(1.0, abs(r)):
             continue
         b = float(r.real)
         if not (-1e-9 < b < 1 + 1e-9) or is_eigenvalue(b):
             continue
-        b = _polish(model, b)
+        b = _polish(parts, b)
         if not (0 < b < 1) or any(abs(b - x) < 1e-10 for x in betas) or is_eigenvalue(b):
             continue
         betas.append(b)
     return betas
 
 
-def _nontrivial_solution(model: LinearModel, beta: float) -> SelfSimilar:
+def _nontrivial_solution(parts: _Parts, beta: float) -> SelfSimilar:
     """The nontrivial solution of β normalised to |p0| = 1 (τ0 < 0 for the member with
     vertex 0 approaching), with the feasibility checks of section 3.2."""
-    q0, p0 = selfsimilar_state(model, beta, 1.0)
+    q0, p0 = _state(parts, beta, 1.0)
     tau0 = 1.0
-    s = 1.0 / np.linalg.norm(p0)
-    if model.F[0] @ p0 > 0:
+    s = 1.0 / math.sqrt(_dot(p0, p0))
+    if _dot(parts.floats.f0, p0) > 0:
         # the member with approaching vertex 0 has τ0 < 0
         s, tau0 = -s, -1.0
-    p0, q0, tau0 = p0 * s, q0 * s * s, tau0 * abs(s)
-    checks = feasibility_checks(model, q0, p0, tau0, beta)
+    p0, q0, tau0 = np.array(p0) * s, np.array(q0) * s * s, tau0 * abs(s)
+    checks = _feasibility(parts, q0, p0, tau0, beta)
     return SelfSimilar(beta, False, tau0, q0, p0, checks, all(checks.values()))
 
 
@@ -374,14 +452,13 @@ def selfsimilar_solutions(model: LinearModel, with_stability: bool = True) -> li
     eigenvalues of the Jacobian of C̄ at it (section 3.3).  Sorted by β."""
     if model.n_contacts < 3:
         raise ValueError("self-similar motion is defined for n >= 3")
-    out, real_eigs = _trivial_solutions(model)
-    out += [_nontrivial_solution(model, b) for b in _nontrivial_betas(model, real_eigs)]
+    parts = _parts(model)
+    out, real_eigs = _trivial_solutions(parts)
+    out += [_nontrivial_solution(parts, b) for b in _nontrivial_betas(parts, real_eigs)]
     if with_stability:
         for sol in out:
-            if sol.tau0 < 0:
-                continue
-            J = reduced_map_jacobian(model, sol.p0, sol.q0)
-            sol.eigenvalues = np.linalg.eigvals(J)
+            if sol.tau0 >= 0:
+                sol.eigenvalues = np.linalg.eigvals(_jacobian(parts, sol.p0, sol.q0))
     out.sort(key=lambda s: s.beta)
     return out
 
