@@ -147,7 +147,7 @@ def test_product_gives_the_oracles_impacts_on_generated_scenes(name, scene, n_co
 @pytest.mark.slow
 def test_product_gives_the_oracles_impacts_on_the_whole_rolling_polygon():
     """polygon25-rolling to its end (1,928 impacts in sustained rolling; the oracle takes
-    ~15 s)."""
+    ~9 s)."""
     scene = resolve_scene("polygon25-rolling")
     assert_same_impacts(simulate(scene), oracle_simulate(scene), None, scene)
 
