@@ -84,10 +84,12 @@ def build(output_dir: Path = CORE_DIR) -> Path:
 def build_counting(output_dir: Path = CORE_DIR) -> tuple[Path, dict[str, int]]:
     """`build`, and the signatures compiled of each core function (`signature_counts`).
     The loop's own layers are compiled to LLVM IR only (LOOP_LAYERS), where this numba
-    allows it."""
+    allows it, and each inlined function's untyped IR is built once
+    (`inline_once.callee_ir_once`)."""
     from reference.compiled import STAMP_FILE, jit_function, source_stamp
 
     from . import ir_only
+    from .inline_once import callee_ir_once
 
     output_dir.mkdir(parents=True, exist_ok=True)
     for old in [*output_dir.glob("_aot*.so"), output_dir / STAMP_FILE.name]:
@@ -102,7 +104,10 @@ def build_counting(output_dir: Path = CORE_DIR) -> tuple[Path, dict[str, int]]:
     for name, sig in signatures().items():
         cc.export(name, sig)(jit_function(name).py_func)
     only_ir = ir_only.available()
-    with ir_only.ir_only(in_loop_layers) if only_ir else contextlib.nullcontext():
+    with (
+        ir_only.ir_only(in_loop_layers) if only_ir else contextlib.nullcontext(),
+        callee_ir_once(),
+    ):
         compile_with_helpers_beside(cc)
         counts = signature_counts()
     (output_dir / STAMP_FILE.name).write_text(source_stamp() + "\n")
