@@ -71,12 +71,14 @@ def to_rotation_vector(q: np.ndarray) -> np.ndarray:
 
 
 def rotation_rows(q) -> tuple[tuple[float, float, float], ...]:
-    """The rows of the rotation matrix R of q (floats w, x, y, z)."""
+    """The rows of the rotation matrix R of q (floats w, x, y, z); its third column is
+    the symmetry axis R ẑ (`axis`)."""
     w, x, y, z = q
+    e0, e1, e2 = axis(q)
     return (
-        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
-        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
-        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
+        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), e0),
+        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), e1),
+        (2 * (x * z - w * y), 2 * (y * z + w * x), e2),
     )
 
 
