@@ -109,7 +109,7 @@ $(AOT): $(BUILD_DEPS) $(CORE)
 # filled once the packages are in (PACKAGES: the install it waits for), while the core's
 # build still runs
 PACKAGES ?= $(STAMP)
-$(WARM): $(PACKAGES) $(CORE) $(LINEAR)
+$(WARM): $(PACKAGES) $(CORE) $(LINEAR) reference/warm.py
 	@echo "set-up 3/3, then: the linear model's kernel into numba's cache"
 	$(BIN)/python -m reference.warm
 	touch $(WARM)

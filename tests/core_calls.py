@@ -11,16 +11,18 @@ the loop's, loaded from numba's cache where the core's build left it."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
 from reference.core.dop853 import heun_euler_step, integrate_held
-from reference.core.held import held_rhs, project_held
+from reference.core.held import held_rhs, project_held, solve_lcp, zero_normal_velocities
 from reference.core.jit import FALSE, ZERO, copy_into
 from reference.core.output import Output
 from reference.core.phases import NO_GRID
 from reference.core.records import RUN
-from reference.core.search import find_flight_event
+from reference.core.search import examine_range, find_flight_event
 
 MAX_ITERATIONS = 100_000  # the flight search's cap, as the loop passes it (a constant)
 
@@ -38,15 +40,12 @@ def held_list(idx) -> np.ndarray:
 
 
 @njit
-def _integrate(y, s_end, model, pts, idx, m, rtol, atol, run, watch, n_watch):
+def _integrate(y, s_end, model, pts, idx, m, rtol, atol, run, watch, n_watch, rows):
     ws, state = run.scratch, run.state
     copy_into(ws.y_chunk, y)
     copy_into(ws.atol, atol)
     copy_into(state.active, idx)
-    out = Output(
-        np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
-        np.zeros((1, 6)), np.zeros(1), run.counts,
-    )  # fmt: skip
+    out = Output(rows[0], rows[1], rows[2], rows[3], rows[4], rows[5], run.counts)
     r = integrate_held(
         ws.y_chunk, s_end, model, pts, state.active, m, rtol, ws.atol, ws, ws, NO_GRID, out,
         (0.0, 0.0), ZERO, FALSE, watch, n_watch, 0.0, FALSE,
@@ -60,8 +59,12 @@ def integrate_held_as_the_loop_does(y, s_end, model, pts, idx, m, rtol, atol, wa
     lift-off not watched, and the gaps of `watch` (contacts) watched when given."""
     watch = np.zeros(0, dtype=np.int64) if watch is None else watch
     run = new_run()
+    # the output's rows (none written: no samples), allocated here: np.zeros inside the
+    # wrapper would compile numba's allocation for it
+    rows = (np.zeros((1, 2)), np.zeros((1, 13)), np.zeros((1, 2)), np.zeros((1, 6)),
+            np.zeros((1, 6)), np.zeros(1))  # fmt: skip
     return _integrate(
-        y, s_end, model, pts, held_list(idx), m, rtol, atol, run[0], watch, len(watch)
+        y, s_end, model, pts, held_list(idx), m, rtol, atol, run[0], watch, len(watch), rows
     )
 
 
@@ -137,3 +140,77 @@ def find_flight_event_as_the_loop_does(y0, fc, bounds, model, pts, window, s_sta
     return _find_flight_event(
         y0, fc, bounds, model, pts, window, s_start, horizon, y, together, run[0]
     )
+
+
+@functools.cache
+def _on_state(fn):
+    @njit
+    def call(y, run, *args):
+        state = run.state
+        copy_into(state.y, y)
+        result = fn(state.y, *args)
+        copy_into(y, state.y)
+        return result
+
+    return call
+
+
+def on_the_loops_state(fn, y, *args):
+    """fn(y, *args), y (updated in place) passed as the loop passes a state: a 13-vector
+    field of its run record.  For the core functions whose only array the loop passes
+    from its records is the state, their first argument."""
+    run = new_run()
+    return _on_state(fn)(y, run[0], *args)
+
+
+@njit
+def _examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius, run):
+    ws, state = run.scratch, run.state
+    copy_into(state.y, y)
+    copy_into(ws.res, res)
+    examine_range(state.y, acc, jet, pts, n, K, B, first, count, vnoise, ws.res, radius)
+    copy_into(res, ws.res)
+
+
+def examine_range_as_the_loop_does(y, acc, jet, pts, n, K, B, first, count, vnoise, res,
+                                   radius):  # fmt: skip
+    """search.examine_range of vertices first … first + count − 1 (mod n) into res (the
+    search's five numbers, updated in place)."""
+    run = new_run()
+    _examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius, run[0])
+
+
+@njit
+def _zero_normal_velocities(y, model, pts, idx, m, run):
+    ws, state = run.scratch, run.state
+    copy_into(state.y, y)
+    copy_into(state.active, idx)
+    ok = zero_normal_velocities(state.y, model, pts, state.active, m, ws)
+    copy_into(y, state.y)
+    return ok
+
+
+def zero_normal_velocities_as_the_loop_does(y, model, pts, idx, m):
+    """held.zero_normal_velocities of contacts idx[:m] on y (updated in place); False
+    where its linear solve failed."""
+    run = new_run()
+    return _zero_normal_velocities(y, model, pts, held_list(idx), m, run[0])
+
+
+@njit
+def _solve_lcp(y, model, pts, cand, m, run, active):
+    ws, state = run.scratch, run.state
+    copy_into(state.y, y)
+    copy_into(ws.cand, cand)
+    n = solve_lcp(state.y, model, pts, ws.cand, m, ws, ws.active)
+    copy_into(active, ws.active)
+    return n
+
+
+def solve_lcp_as_the_loop_does(y, model, pts, cand, m, active):
+    """held.solve_lcp of candidates cand[:m]: the contacts it holds into active[:n] (an
+    array of four), n returned (−1: no admissible set)."""
+    run = new_run()
+    padded = np.zeros(4, dtype=np.int64)
+    padded[:m] = cand[:m]
+    return _solve_lcp(y, model, pts, padded, m, run[0], active)

@@ -14,7 +14,11 @@ from reference.core.records import EVENT_IMPACT, EVENT_NONE, RIM_VERTEX_ON_PLANE
 from reference.geometry import initial_state
 from reference.scene import Body, Ground, InitialState, RunSettings, Scene, initial_from_linear
 from tests.conftest import core_model, flight, gaps, make_scene
-from tests.core_calls import find_flight_event_as_the_loop_does
+from tests.core_calls import (
+    examine_range_as_the_loop_does,
+    find_flight_event_as_the_loop_does,
+    on_the_loops_state,
+)
 from tests.oracle.body import BodyModel
 from tests.oracle.events import next_flight_event
 from tests.oracle.flight import flight_constants as oracle_flight_constants
@@ -68,7 +72,7 @@ def _random_flights(n: int, count: int, seed: int):
 def _product_event(scene, y, window):
     model, pts = core_model(scene)
     fc = flight_constants(y, scene.body.inertia_diag[0], scene.body.inertia_diag[2])
-    bounds = flight_bounds(y, fc, model, pts, 10.0)
+    bounds = on_the_loops_state(flight_bounds, y, fc, model, pts, 10.0)
     out, together = y.copy(), np.empty(len(pts), dtype=np.int64)  # out: the state at 0
     ev = find_flight_event_as_the_loop_does(y, fc, bounds, model, pts, window, 0.0, 10.0, out,
                                             together)  # fmt: skip
@@ -154,7 +158,7 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
     from reference.core.contacts import contact_jet, rim_jet
     from reference.core.flight import flight_acceleration
     from reference.core.roots import safe_step
-    from reference.core.search import STEP, STEP_K, examine_range
+    from reference.core.search import STEP, STEP_K
     from reference.core.tolerances import ROOT_REL_TOL
 
     scene = make_scene(n=64)
@@ -170,15 +174,16 @@ def test_examining_the_likeliest_vertex_first_gives_the_least_step(seed):
         y[7:10] = rng.normal(size=3) * 0.3
         y[10:13] = rng.normal(size=3) * [1.0, 1.0, rng.choice([1.0, 30.0])]
         fc = flight_constants(y, i1, i3)
-        bounds = flight_bounds(y, fc, model, pts, 10.0)
+        bounds = on_the_loops_state(flight_bounds, y, fc, model, pts, 10.0)
         acc = flight_acceleration(fc, y, scene.gravity)
         res = np.array([np.inf, -1.0, np.inf, -1.0, -1.0])
-        jet = rim_jet(y, acc, 1.0)
-        examine_range(y, acc, jet, pts, 64, bounds.K, bounds.B, 0, 64, 1e-14, res, 1.0)
+        jet = on_the_loops_state(rim_jet, y, acc, 1.0)
+        examine_range_as_the_loop_does(y, acc, jet, pts, 64, bounds.K, bounds.B, 0, 64, 1e-14, res,
+                                       1.0)  # fmt: skip
         alone = []
         for k in range(64):
             j = contact_jet(y, RIM_VERTEX_ON_PLANE, pts, k, acc)
-            alone.append(safe_step(j.gap, j.rate, j.accel, bounds.K, bounds.B))
+            alone.append(safe_step(j.gap, j.rate, j.accel, bounds.K, bounds.B, np.inf))
         order = np.argsort(alone)
         least = alone[order[0]]
         assert least <= res[STEP] <= least / (1 - ROOT_REL_TOL)
@@ -228,8 +233,8 @@ def test_circle_step_is_within_its_tolerance_below_the_circle_bound_root(seed):
             y[3:7] = qt.from_rotation_vector([tilt, 0.0, 0.0])  # linear to its root
             y[10:13] = [rng.choice([-1.0, 1.0]), 0.0, 0.0]
         fc = flight_constants(y, i1, i3)
-        bounds = flight_bounds(y, fc, model, pts, 10.0)
-        jet = rim_jet(y, flight_acceleration(fc, y, scene.gravity), 1.0)
+        bounds = on_the_loops_state(flight_bounds, y, fc, model, pts, 10.0)
+        jet = on_the_loops_state(rim_jet, y, flight_acceleration(fc, y, scene.gravity), 1.0)
         step = circle_step(y, jet, scene.gravity, bounds.B)
         if not y[2] - np.hypot(jet[0], jet[1]) > 0:  # F(0): the circle's lowest point
             continue
@@ -273,10 +278,10 @@ def test_others_safe_time_ends_before_any_other_contact_reaches_the_ground():
         y[9] += 0.3 - j.rate  # vertex k moving away at 0.3
         fc = flight_constants(y, i1, i3)
         acc = flight_acceleration(fc, y, scene.gravity)
-        bounds = flight_bounds(y, fc, model, pts, 10.0)
+        bounds = on_the_loops_state(flight_bounds, y, fc, model, pts, 10.0)
         end = 10.0
-        t = _others_safe_time(y, acc, model, pts, k, end, 0.0, bounds.K, bounds.B, False,
-                              rate_noise(y, 1.0))  # fmt: skip
+        t = on_the_loops_state(_others_safe_time, y, acc, model, pts, k, end, 0.0, bounds.K,
+                               bounds.B, False, rate_noise(y, 1.0))  # fmt: skip
         assert t > 0
         others = np.delete(np.arange(7), k)
         for s in np.linspace(0.0, t, 200)[1:]:
