@@ -25,7 +25,9 @@ CORE   := $(wildcard reference/core/*.py)
 LINEAR := $(wildcard reference/linear/*.py)
 WARM   := $(VENV)/.warm
 NO_CORE_BUILD := EULER_DISK_BUILD_CORE=0
-BUILD_REQUIRES = $(shell $(PYTHON) -c 'import shlex, tomllib; print(shlex.join(tomllib.load(open("pyproject.toml", "rb"))["build-system"]["requires"]))')
+# (read once, where first needed: each reading starts a Python)
+BUILD_REQUIRES = $(eval BUILD_REQUIRES := $(shell $(PYTHON) -c 'import shlex, tomllib; \
+	print(shlex.join(tomllib.load(open("pyproject.toml", "rb"))["build-system"]["requires"]))'))$(BUILD_REQUIRES)
 
 .PHONY: setup demo test test-slow lint bench figures docs-figures browser clean
 

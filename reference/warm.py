@@ -4,12 +4,14 @@
 The exact model's event loop is in the ahead-of-time module (`reference.core.aot`); the
 paper's linearised model (`reference/linear/kernel.py`) is compiled by numba on its first
 run and cached in `reference/linear/__pycache__`.  One short linear run under an impact
-law compiles its kernel (the law's path included: the kernel is one compiled loop), and
-one impact of `reference.linear.laws.apply_law` the law event's helpers that Python calls
-on their own (compiled into the kernel, they have no machine code of their own), so that
-the first `harness ... --engine linear` or `apply_law` and every process of the test
-suite load them from the cache instead of compiling them again.  The results are
-discarded."""
+law compiles its kernel (the law's path included: the kernel is one compiled loop); one
+impact of `reference.linear.laws.apply_law` compiles the law event's helpers that Python
+calls on their own (compiled into the kernel, they have no machine code of their own);
+a call of each of the kernel's other functions that Python calls (the self-similar
+analysis' root, the energy exponent's sums in log space) compiles those.  The first
+`harness ... --engine linear`, `apply_law` or `sweep exponent` and every process of the
+test suite then load them from the cache instead of compiling them again.  The results
+are discarded (tests/test_warm.py checks that every such function is called)."""
 
 from __future__ import annotations
 
@@ -50,9 +52,26 @@ def warm_law_impulses() -> float:
     return time.perf_counter() - t0
 
 
+def warm_python_calls() -> float:
+    """The kernel's other functions that Python calls: `first_hit` (the self-similar
+    analysis) and `log2_time_to_go` and `log2_segment_sums` (the energy exponent's
+    estimators, reference.linear.exponent_estimates), on three intervals; returns the
+    seconds taken."""
+    import numpy as np
+
+    from reference.linear import kernel as K
+
+    log2_dt = np.array([-np.inf, -1.0, -2.0])
+    t0 = time.perf_counter()
+    K.first_hit(1.0, -1.0, -1.0)
+    K.log2_time_to_go(log2_dt, -3.0)
+    K.log2_segment_sums(log2_dt, np.array([0, 2], dtype=np.int64))
+    return time.perf_counter() - t0
+
+
 def main() -> int:
     print("compiling the linear model's kernel into numba's cache ...", flush=True)
-    seconds = warm_linear_kernel() + warm_law_impulses()
+    seconds = warm_linear_kernel() + warm_law_impulses() + warm_python_calls()
     print(f"the linear model's kernel is in numba's cache ({seconds:.0f} s)", flush=True)
     return 0
 
