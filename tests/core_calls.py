@@ -39,6 +39,46 @@ def held_list(idx) -> np.ndarray:
     return active
 
 
+@functools.cache
+def _on_state(fn):
+    """fn(state.y, *args) compiled once per fn, y copied in and out (on_the_loops_state)."""
+
+    @njit
+    def call(y, run, *args):
+        state = run.state
+        copy_into(state.y, y)
+        result = fn(state.y, *args)
+        copy_into(y, state.y)
+        return result
+
+    return call
+
+
+@functools.cache
+def _on_held_contacts(fn):
+    """fn(state.y, model, pts, state.active, m, scratch) compiled once per fn: the held
+    contacts' functions of reference.core.held, called as the loop calls them."""
+
+    @njit
+    def call(y, model, pts, idx, m, run):
+        state = run.state
+        copy_into(state.y, y)
+        copy_into(state.active, idx)
+        result = fn(state.y, model, pts, state.active, m, run.scratch)
+        copy_into(y, state.y)
+        return result
+
+    return call
+
+
+def on_the_loops_state(fn, y, *args):
+    """fn(y, *args), y (updated in place) passed as the loop passes a state: a 13-vector
+    field of its run record.  For the core functions whose only array the loop passes
+    from its records is the state, their first argument."""
+    run = new_run()
+    return _on_state(fn)(y, run[0], *args)
+
+
 @njit
 def _integrate(y, s_end, model, pts, idx, m, rtol, atol, run, watch, n_watch, rows):
     ws, state = run.scratch, run.state
@@ -103,21 +143,10 @@ def held_rhs_as_the_loop_does(y, model, pts, idx, m, dy):
     _held_rhs(y, model, pts, held_list(idx), m, run[0], dy)
 
 
-@njit
-def _project_held(y, model, pts, idx, m, run):
-    ws, state = run.scratch, run.state
-    copy_into(ws.y_chunk, y)
-    copy_into(state.active, idx)
-    projected = project_held(ws.y_chunk, model, pts, state.active, m, ws)
-    copy_into(y, ws.y_chunk)
-    return projected
-
-
 def project_held_as_the_loop_does(y, model, pts, idx, m):
     """held.project_held: y (updated in place) projected onto the constraints of contacts
     idx[:m]; False where its linear solve failed."""
-    run = new_run()
-    return _project_held(y, model, pts, held_list(idx), m, run[0])
+    return _on_held_contacts(project_held)(y, model, pts, held_list(idx), m, new_run()[0])
 
 
 @njit
@@ -142,27 +171,6 @@ def find_flight_event_as_the_loop_does(y0, fc, bounds, model, pts, window, s_sta
     )
 
 
-@functools.cache
-def _on_state(fn):
-    @njit
-    def call(y, run, *args):
-        state = run.state
-        copy_into(state.y, y)
-        result = fn(state.y, *args)
-        copy_into(y, state.y)
-        return result
-
-    return call
-
-
-def on_the_loops_state(fn, y, *args):
-    """fn(y, *args), y (updated in place) passed as the loop passes a state: a 13-vector
-    field of its run record.  For the core functions whose only array the loop passes
-    from its records is the state, their first argument."""
-    run = new_run()
-    return _on_state(fn)(y, run[0], *args)
-
-
 @njit
 def _examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius, run):
     ws, state = run.scratch, run.state
@@ -180,21 +188,11 @@ def examine_range_as_the_loop_does(y, acc, jet, pts, n, K, B, first, count, vnoi
     _examine_range(y, acc, jet, pts, n, K, B, first, count, vnoise, res, radius, run[0])
 
 
-@njit
-def _zero_normal_velocities(y, model, pts, idx, m, run):
-    ws, state = run.scratch, run.state
-    copy_into(state.y, y)
-    copy_into(state.active, idx)
-    ok = zero_normal_velocities(state.y, model, pts, state.active, m, ws)
-    copy_into(y, state.y)
-    return ok
-
-
 def zero_normal_velocities_as_the_loop_does(y, model, pts, idx, m):
     """held.zero_normal_velocities of contacts idx[:m] on y (updated in place); False
     where its linear solve failed."""
-    run = new_run()
-    return _zero_normal_velocities(y, model, pts, held_list(idx), m, run[0])
+    call = _on_held_contacts(zero_normal_velocities)
+    return call(y, model, pts, held_list(idx), m, new_run()[0])
 
 
 @njit
