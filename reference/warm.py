@@ -24,21 +24,16 @@ WARM_SCENE = "triangle-chatter"  # a built-in scene with a simultaneous impact
 WARM_LAW = "moreau"
 
 
-def warm_linear_kernel() -> float:
-    """Run the linear model once on WARM_SCENE under WARM_LAW; returns the seconds taken
-    (the compilation, or the cache's loading when it is already filled)."""
+def warm_linear_kernel() -> None:
+    """Run the linear model once on WARM_SCENE under WARM_LAW."""
     from reference.linear.simulate import simulate_linear
     from reference.scenes import load_scene
 
-    scene = dataclasses.replace(load_scene(WARM_SCENE), impact_law=WARM_LAW)
-    t0 = time.perf_counter()
-    simulate_linear(scene)
-    return time.perf_counter() - t0
+    simulate_linear(dataclasses.replace(load_scene(WARM_SCENE), impact_law=WARM_LAW))
 
 
-def warm_law_impulses() -> float:
-    """One impact of `apply_law` under WARM_LAW (a triangle's contact 0 approaching);
-    returns the seconds taken."""
+def warm_law_impulses() -> None:
+    """One impact of `apply_law` under WARM_LAW (a triangle's contact 0 approaching)."""
     import numpy as np
 
     from reference.core.laws import law_code
@@ -47,31 +42,38 @@ def warm_law_impulses() -> float:
 
     model = LinearModel.polygon(3, 0.5, 0.5)
     p = np.array([0.0, 0.0, -1.0])
-    t0 = time.perf_counter()
     apply_law(model.F, model.theta, model.restitution, p, [0], law_code(WARM_LAW))
-    return time.perf_counter() - t0
 
 
-def warm_python_calls() -> float:
+def warm_python_calls() -> None:
     """The kernel's other functions that Python calls: `first_hit` (the self-similar
     analysis) and `log2_time_to_go` and `log2_segment_sums` (the energy exponent's
-    estimators, reference.linear.exponent_estimates), on three intervals; returns the
-    seconds taken."""
+    estimators, reference.linear.exponent_estimates), on three intervals."""
     import numpy as np
 
     from reference.linear import kernel as K
 
     log2_dt = np.array([-np.inf, -1.0, -2.0])
-    t0 = time.perf_counter()
     K.first_hit(1.0, -1.0, -1.0)
     K.log2_time_to_go(log2_dt, -3.0)
     K.log2_segment_sums(log2_dt, np.array([0, 2], dtype=np.int64))
+
+
+WARM_STEPS = (warm_linear_kernel, warm_law_impulses, warm_python_calls)
+
+
+def warm_all() -> float:
+    """Every step of WARM_STEPS; returns the seconds taken (the compilation, or the
+    cache's loading when it is already filled)."""
+    t0 = time.perf_counter()
+    for step in WARM_STEPS:
+        step()
     return time.perf_counter() - t0
 
 
 def main() -> int:
     print("compiling the linear model's kernel into numba's cache ...", flush=True)
-    seconds = warm_linear_kernel() + warm_law_impulses() + warm_python_calls()
+    seconds = warm_all()
     print(f"the linear model's kernel is in numba's cache ({seconds:.0f} s)", flush=True)
     return 0
 

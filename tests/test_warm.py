@@ -33,9 +33,7 @@ def test_the_warm_up_calls_every_function_of_the_linear_kernel_that_python_calls
     calls: dict[str, set] = {}
     for name in K.PYTHON_ENTRY_POINTS | LAW_HELPERS:
         monkeypatch.setattr(K, name, _recording(getattr(K, name), name, calls))
-    warm.warm_linear_kernel()
-    warm.warm_law_impulses()
-    warm.warm_python_calls()
+    warm.warm_all()
     assert set(calls) == K.PYTHON_ENTRY_POINTS | LAW_HELPERS
 
 

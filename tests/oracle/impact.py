@@ -40,7 +40,8 @@ def impact_impulse(
     idx = range(model.n_contacts) if watch is None else [k, *watch]
     s = state(y)
     cs = model.contact_list(s, idx)
-    ck = cs[k if watch is None else 0]
+    row = k if watch is None else 0  # contact k's place in cs
+    ck = cs[row]
     w = model.delassus(s, [ck])[0][0]  # J_k M⁻¹ J_kᵀ
     u_pre = ck.vn
     zeta = -(1.0 + gamma) * u_pre / w
@@ -52,7 +53,7 @@ def impact_impulse(
     vn_idx = [row_dot(c, v, om) for c in cs]
     vn_post = np.full(model.n_contacts, np.nan)
     vn_post[list(idx)] = vn_idx
-    return ImpactResult(y_post, zeta, u_pre, vn_idx[k if watch is None else 0], vn_post)
+    return ImpactResult(y_post, zeta, u_pre, vn_idx[row], vn_post)
 
 
 def apply_normal_impulses(
